@@ -1,0 +1,61 @@
+#include "drivers/backend.hpp"
+
+#include <cstdlib>
+#include <sstream>
+
+namespace kushner {
+
+std::vector<std::string> available_backends() {
+  std::vector<std::string> names;
+#if defined(KOKKOS_ENABLE_CUDA)
+  names.emplace_back("cuda");
+#endif
+#if defined(KOKKOS_ENABLE_OPENMP)
+  names.emplace_back("openmp");
+#endif
+#if defined(KOKKOS_ENABLE_SERIAL)
+  names.emplace_back("serial");
+#endif
+  return names;
+}
+
+std::string selected_backend() {
+  const auto names = available_backends();
+  const char* env = std::getenv("KUSHNER_BACKEND");
+  if (env == nullptr || *env == '\0') return names.front();
+  for (const auto& n : names)
+    if (n == env) return n;
+  std::string known;
+  for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
+  throw InputError(std::string("KUSHNER_BACKEND: backend '") + env + "' is not available (built: " + known + ")");
+}
+
+nlohmann::json describe_backend(const std::string& name) {
+  std::ostringstream kokkos;
+  kokkos << KOKKOS_VERSION / 10000 << "." << (KOKKOS_VERSION / 100) % 100 << "." << KOKKOS_VERSION % 100;
+  nlohmann::json j = {{"name", name}, {"kokkos", kokkos.str()}};
+#if defined(KOKKOS_ENABLE_CUDA)
+  if (name == "cuda") {
+    const Kokkos::Cuda cuda;
+    j["device"] = cuda.cuda_device_prop().name;
+    return j;
+  }
+#endif
+#if defined(KOKKOS_ENABLE_OPENMP)
+  if (name == "openmp") j["threads"] = Kokkos::OpenMP().concurrency();
+#endif
+  if (name == "serial") j["threads"] = 1;
+  return j;
+}
+
+KokkosSession::KokkosSession() {
+  setenv("OMP_PROC_BIND", "false", /*overwrite=*/0);
+  int argc = 1;
+  char name[] = "kushner";
+  char* argv[] = {name, nullptr};
+  Kokkos::initialize(argc, argv);
+}
+
+KokkosSession::~KokkosSession() { Kokkos::finalize(); }
+
+}  // namespace kushner

@@ -1,0 +1,50 @@
+#pragma once
+// Which Kokkos execution space a run uses. The command line says what to compute; the environment says
+// where: KUSHNER_BACKEND=serial|openmp|cuda (default: Kokkos' default execution space) and OMP_NUM_THREADS.
+// So the recorded command, and every per-member number, is the same whatever backend ran it.
+#include "kernels/errors.hpp"
+
+#include <Kokkos_Core.hpp>
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+#include <vector>
+
+namespace kushner {
+
+/// Backends compiled into this binary, default first.
+std::vector<std::string> available_backends();
+
+/// KUSHNER_BACKEND if set (checked against available_backends(): InputError otherwise), else the default.
+std::string selected_backend();
+
+/// {"name", "threads" or "device", "kokkos"}: recorded in every summary. Needs Kokkos initialized.
+nlohmann::json describe_backend(const std::string& name);
+
+/// Calls f(space) with an instance of the execution space called `name`.
+template <class F>
+void with_backend(const std::string& name, F&& f) {
+#if defined(KOKKOS_ENABLE_CUDA)
+  if (name == "cuda") return f(Kokkos::Cuda());
+#endif
+#if defined(KOKKOS_ENABLE_OPENMP)
+  if (name == "openmp") return f(Kokkos::OpenMP());
+#endif
+#if defined(KOKKOS_ENABLE_SERIAL)
+  if (name == "serial") return f(Kokkos::Serial());
+#endif
+  KUSHNER_REQUIRE(false, "backend '" << name << "' is not compiled in");
+}
+
+/// Kokkos::initialize / finalize around a run. Sets OMP_PROC_BIND=false when unset, which is libgomp's
+/// default anyway, because Kokkos 3.4 otherwise prints a warning to stdout on every start.
+class KokkosSession {
+ public:
+  KokkosSession();
+  ~KokkosSession();
+  KokkosSession(const KokkosSession&) = delete;
+  KokkosSession& operator=(const KokkosSession&) = delete;
+};
+
+}  // namespace kushner

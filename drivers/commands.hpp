@@ -1,0 +1,18 @@
+#pragma once
+// The subcommands of `kushner`. Each validates all its input before opening any output and throws
+// InputError for bad input; main() turns that into one line on stderr and exit code 2.
+#include "drivers/run_metadata.hpp"
+#include "drivers/run_options.hpp"
+
+namespace kushner {
+
+/// `kushner simulate`: the bank of truths; writes summary.json and timeseries.csv.
+int run_simulate(const RunOptions& options, const RunContext& context);
+
+/// `kushner models`: the built-in models and their parameters.
+int run_models(bool json);
+
+/// `kushner --version`: versions, the backend in use and its threads or device.
+int run_version();
+
+}  // namespace kushner

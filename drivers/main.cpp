@@ -1,0 +1,94 @@
+// kushner: banks of nonlinear stochastic systems and filters. Command-line entry point.
+#include "drivers/backend.hpp"
+#include "drivers/commands.hpp"
+#include "drivers/config_file.hpp"
+#include "kernels/errors.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <iostream>
+#include <memory>
+
+namespace kushner {
+namespace {
+
+struct Options {
+  bool version = false;
+  RunOptions simulate;
+  bool models_json = false;
+};
+
+std::unique_ptr<CLI::App> make_app(Options& o) {
+  auto app = std::make_unique<CLI::App>(
+      "kushner: banks of nonlinear stochastic systems and filters, measured against the true conditional "
+      "density.\nWhere it runs: KUSHNER_BACKEND=serial|openmp|cuda, OMP_NUM_THREADS.",
+      "kushner");
+  app->require_subcommand(0, 1);
+  app->add_flag("--version", o.version, "print versions, the backend and its threads or device");
+  add_run_options(*app->add_subcommand("simulate", "simulate the bank of truths and observations"), o.simulate);
+  app->add_subcommand("models", "list the built-in models and their parameters")
+      ->add_flag("--json", o.models_json, "as JSON");
+  return app;
+}
+
+/// Parses argv; when the chosen subcommand has --config FILE, parses again with the file's options placed
+/// before the command line's own (which therefore win). Returns nullptr after printing --help.
+std::unique_ptr<CLI::App> parse(int argc, char** argv, Options& o) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  auto app = make_app(o);
+  std::vector<std::string> reversed(args.rbegin(), args.rend());  // CLI11 consumes a reversed vector
+  try {
+    app->parse(reversed);
+  } catch (const CLI::Success& e) {  // --help: printed by the app that parsed it, for the right subcommand
+    app->exit(e);
+    return nullptr;
+  }
+  const auto subcommands = app->get_subcommands();
+  if (subcommands.empty() || subcommands[0]->get_option("--config")->count() == 0) return app;
+  CLI::App* sub = subcommands[0];
+  const std::string path = sub->get_option("--config")->as<std::string>();
+  std::vector<std::string> expanded = config_file_arguments(path, *sub);
+  const auto at = std::find(args.begin(), args.end(), sub->get_name());
+  expanded.insert(expanded.begin(), args.begin(), at + 1);
+  expanded.insert(expanded.end(), at + 1, args.end());
+  o = Options{};
+  app = make_app(o);
+  reversed.assign(expanded.rbegin(), expanded.rend());
+  app->parse(reversed);
+  return app;
+}
+
+int run(int argc, char** argv) {
+  Options o;
+  const std::unique_ptr<CLI::App> app = parse(argc, argv, o);
+  if (!app) return 0;
+  RunContext context{command_line(argc, argv), 0, ""};
+  if (o.version) return run_version();
+  if (app->got_subcommand("models")) return run_models(o.models_json);
+  if (app->got_subcommand("simulate")) {
+    context.seed = static_cast<std::uint32_t>(o.simulate.seed);
+    context.backend = selected_backend();
+    return run_simulate(o.simulate, context);
+  }
+  std::cout << app->help();
+  return 0;
+}
+
+}  // namespace
+}  // namespace kushner
+
+int main(int argc, char** argv) {
+  try {
+    return kushner::run(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    std::cerr << "kushner: error: " << e.what() << "\n";
+    return 2;
+  } catch (const kushner::InputError& e) {
+    std::cerr << "kushner: error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "kushner: internal error: " << e.what() << "\n";
+    return 1;
+  }
+}

@@ -1,0 +1,56 @@
+#include "drivers/backend.hpp"
+#include "drivers/commands.hpp"
+#include "drivers/csv.hpp"
+#include "drivers/output_directory.hpp"
+#include "drivers/simulate_ensemble.hpp"
+#include "models/registry.hpp"
+
+namespace kushner {
+
+namespace {
+
+template <class Model>
+std::string timeseries_csv(const MomentSeries& series, const RunContext& context) {
+  std::string csv = csv_comment(context) + "t";
+  for (int i = 1; i <= Model::state_dim; ++i)
+    csv += ",mean_x" + std::to_string(i) + ",var_x" + std::to_string(i);
+  csv += "\n";
+  for (std::size_t r = 0; r < series.times.size(); ++r) {
+    csv += format_number(series.times[r]);
+    for (int i = 0; i < Model::state_dim; ++i)
+      csv += "," + format_number(series.moments[r].mean[i]) + "," + format_number(series.moments[r].variance[i]);
+    csv += "\n";
+  }
+  return csv;
+}
+
+}  // namespace
+
+int run_simulate(const RunOptions& options, const RunContext& context) {
+  validate_run_options(options);
+  const TimeGrid grid = make_time_grid(options.T, options.dt, options.output_points);
+  with_model(options.model, options.sets, [&](const auto& model) {
+    using Model = std::decay_t<decltype(model)>;
+    const OutputDirectory out(options.out, "--out");
+    KokkosSession kokkos;
+    with_backend(context.backend, [&](const auto& space) {
+      Progress progress("simulate", grid.steps, !options.quiet);
+      const MomentSeries series = simulate_ensemble(space, model, options.members,
+                                                    static_cast<std::uint32_t>(options.seed), grid, &progress);
+      nlohmann::json summary = run_metadata(context);
+      summary["model"] = {{"name", Model::name}, {"state_dim", Model::state_dim}, {"parameters", parameter_values(model)}};
+      summary["members"] = options.members;
+      summary["T"] = options.T;
+      summary["dt"] = options.dt;
+      summary["steps"] = grid.steps;
+      summary["mean_final"] = series.moments.back().mean;
+      summary["var_final"] = series.moments.back().variance;
+      summary["files"] = {"summary.json", "timeseries.csv"};
+      out.write("timeseries.csv", timeseries_csv<Model>(series, context));
+      out.write("summary.json", summary.dump(2) + "\n");
+    });
+  });
+  return 0;
+}
+
+}  // namespace kushner

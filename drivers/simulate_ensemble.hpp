@@ -1,0 +1,71 @@
+#pragma once
+// Simulates the bank of truths over a time grid and records ensemble moments at the grid's output steps.
+// Shared by `kushner simulate`, the tests and the benchmarks.
+#include "drivers/progress.hpp"
+#include "drivers/run_options.hpp"
+#include "kernels/ensemble_moments.hpp"
+#include "kernels/simulate_truth.hpp"
+#include "models/model_checks.hpp"
+
+#include <cstdint>
+#include <vector>
+
+namespace kushner {
+
+struct MomentSeries {
+  std::vector<double> times;
+  std::vector<EnsembleMoments> moments;  // one per time
+};
+
+template <class ExecSpace, class Model>
+class TruthBank {
+ public:
+  using MemSpace = typename ExecSpace::memory_space;
+
+  TruthBank(const ExecSpace& space, const Model& model, long members, std::uint32_t seed)
+      : space_(space),
+        model_(model),
+        seed_(seed),
+        x_("kushner::truth", members, Model::state_dim),
+        observations_("kushner::observations", members, Model::obs_dim) {
+    initialize_gaussian<ExecSpace, Model::state_dim, MemSpace>(space_, x_, model.x0_mean,
+                                                               covariance_square_root(model.x0_cov),
+                                                               RngKey{seed, Stream::truth_initial});
+  }
+
+  /// Step k: [k dt, (k+1) dt].
+  void step(long k, double dt) {
+    simulate_truth_step(space_, model_, x_, observations_, k * dt, dt, seed_, static_cast<std::uint32_t>(k));
+  }
+
+  const BankVector<MemSpace>& state() const { return x_; }
+  const BankVector<MemSpace>& observations() const { return observations_; }
+
+ private:
+  ExecSpace space_;
+  Model model_;
+  std::uint32_t seed_;
+  BankVector<MemSpace> x_, observations_;
+};
+
+template <class ExecSpace, class Model>
+MomentSeries simulate_ensemble(const ExecSpace& space, const Model& model, long members, std::uint32_t seed,
+                               const TimeGrid& grid, Progress* progress = nullptr) {
+  TruthBank<ExecSpace, Model> bank(space, model, members, seed);
+  MomentSeries series;
+  std::size_t next_output = 0;
+  for (long k = 0;; ++k) {
+    if (next_output < grid.output_steps.size() && grid.output_steps[next_output] == k) {
+      series.times.push_back(k * grid.dt);
+      series.moments.push_back(ensemble_moments(space, bank.state()));
+      ++next_output;
+    }
+    if (k == grid.steps) break;
+    bank.step(k, grid.dt);
+    if (progress) progress->update(k + 1);
+  }
+  space.fence();
+  return series;
+}
+
+}  // namespace kushner

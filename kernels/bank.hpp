@@ -1,0 +1,79 @@
+#pragma once
+// The ensemble bank: structure-of-arrays Kokkos Views, member index contiguous, and gather/scatter of one
+// member's small vectors and matrices. LayoutLeft is spelled out because the default layout differs between
+// backends; with it x(member, i) is stride-1 in member, and particles(particle, member, i) is stride-1 in
+// particle within a member.
+#include "kernels/small_matrix.hpp"
+
+#include <Kokkos_Core.hpp>
+
+namespace kushner {
+
+/// (member, i): states, estimates, observation increments.
+template <class MemSpace>
+using BankVector = Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace>;
+
+/// (member, k): symmetric matrices (covariances) packed by rows of the upper triangle, k = 0 .. N(N+1)/2-1.
+/// Storing each off-diagonal entry once keeps P symmetric by construction.
+template <class MemSpace>
+using BankSymmetric = Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace>;
+
+/// (member, i, j): general matrices (gains, Jacobians) when a filter keeps one.
+template <class MemSpace>
+using BankMatrix = Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace>;
+
+/// (particle, member, i): particle states, particle index contiguous within a member.
+template <class MemSpace>
+using ParticleBank = Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace>;
+
+/// (member): one scalar per member (status, counts, log-normalizers).
+template <class T, class MemSpace>
+using BankScalar = Kokkos::View<T*, Kokkos::LayoutLeft, MemSpace>;
+
+constexpr int packed_size(int n) { return n * (n + 1) / 2; }
+
+/// Index of (i, j), i <= j, in the packed upper triangle.
+KOKKOS_INLINE_FUNCTION constexpr int packed_index(int n, int i, int j) {
+  return i * n - i * (i - 1) / 2 + (j - i);
+}
+
+template <int N, class View>
+KOKKOS_INLINE_FUNCTION Vec<N> load(const View& x, int member) {
+  Vec<N> v;
+  for (int i = 0; i < N; ++i) v[i] = x(member, i);
+  return v;
+}
+
+template <int N, class View>
+KOKKOS_INLINE_FUNCTION void store(const View& x, int member, const Vec<N>& v) {
+  for (int i = 0; i < N; ++i) x(member, i) = v[i];
+}
+
+template <int N, class View>
+KOKKOS_INLINE_FUNCTION Mat<N, N> load_symmetric(const View& packed, int member) {
+  Mat<N, N> m;
+  for (int i = 0; i < N; ++i)
+    for (int j = i; j < N; ++j) m(i, j) = m(j, i) = packed(member, packed_index(N, i, j));
+  return m;
+}
+
+/// Stores the symmetric part of m, (m + m^T) / 2.
+template <int N, class View>
+KOKKOS_INLINE_FUNCTION void store_symmetric(const View& packed, int member, const Mat<N, N>& m) {
+  for (int i = 0; i < N; ++i)
+    for (int j = i; j < N; ++j) packed(member, packed_index(N, i, j)) = 0.5 * (m(i, j) + m(j, i));
+}
+
+template <int N, class View>
+KOKKOS_INLINE_FUNCTION Vec<N> load_particle(const View& particles, int particle, int member) {
+  Vec<N> v;
+  for (int i = 0; i < N; ++i) v[i] = particles(particle, member, i);
+  return v;
+}
+
+template <int N, class View>
+KOKKOS_INLINE_FUNCTION void store_particle(const View& particles, int particle, int member, const Vec<N>& v) {
+  for (int i = 0; i < N; ++i) particles(particle, member, i) = v[i];
+}
+
+}  // namespace kushner

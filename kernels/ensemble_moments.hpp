@@ -1,0 +1,77 @@
+#pragma once
+// Ensemble means and variances in a fixed summation order, so that results are bitwise the same on any
+// number of threads: each block of `block_size` consecutive members is reduced sequentially (Welford) by one
+// thread, and the host merges the blocks in order (Chan et al.). A Kokkos parallel_reduce would combine
+// partial sums in an order that depends on the thread count.
+#include "kernels/bank.hpp"
+
+#include <Kokkos_Core.hpp>
+
+#include <vector>
+
+namespace kushner {
+
+constexpr int moment_block_size = 256;
+
+/// blocks(b, 0) = member count of block b; blocks(b, 1 + c) = mean of column c; blocks(b, 1 + K + c) = sum of
+/// squared deviations of column c, over the members of block b (K = columns).
+template <class MemSpace>
+struct BlockMoments {
+  Kokkos::View<const double**, Kokkos::LayoutLeft, MemSpace> x;
+  Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> blocks;
+
+  KOKKOS_INLINE_FUNCTION void operator()(const int b) const {
+    const int columns = static_cast<int>(x.extent(1));
+    const int begin = b * moment_block_size;
+    const int end = begin + moment_block_size < static_cast<int>(x.extent(0)) ? begin + moment_block_size
+                                                                              : static_cast<int>(x.extent(0));
+    blocks(b, 0) = end - begin;
+    for (int c = 0; c < columns; ++c) {
+      double mean = 0.0, m2 = 0.0;
+      for (int m = begin; m < end; ++m) {
+        const double delta = x(m, c) - mean;
+        mean += delta / (m - begin + 1);
+        m2 += delta * (x(m, c) - mean);
+      }
+      blocks(b, 1 + c) = mean;
+      blocks(b, 1 + columns + c) = m2;
+    }
+  }
+};
+
+struct EnsembleMoments {
+  std::vector<double> mean;      // per column
+  std::vector<double> variance;  // per column, sample variance (divisor members - 1)
+};
+
+/// Mean and sample variance of every column of x(member, column) over members.
+template <class ExecSpace, class View>
+EnsembleMoments ensemble_moments(const ExecSpace& space, const View& x) {
+  using MemSpace = typename View::memory_space;
+  const int members = static_cast<int>(x.extent(0));
+  const int columns = static_cast<int>(x.extent(1));
+  const int num_blocks = (members + moment_block_size - 1) / moment_block_size;
+  Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> blocks("kushner::moment_blocks", num_blocks, 1 + 2 * columns);
+  Kokkos::parallel_for("kushner::block_moments", Kokkos::RangePolicy<ExecSpace>(space, 0, num_blocks),
+                       BlockMoments<MemSpace>{x, blocks});
+  space.fence();
+  const auto host = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), blocks);
+
+  EnsembleMoments result{std::vector<double>(columns, 0.0), std::vector<double>(columns, 0.0)};
+  for (int c = 0; c < columns; ++c) {
+    double count = 0.0, mean = 0.0, m2 = 0.0;
+    for (int b = 0; b < num_blocks; ++b) {
+      const double nb = host(b, 0), mean_b = host(b, 1 + c), m2_b = host(b, 1 + columns + c);
+      const double total = count + nb;
+      const double delta = mean_b - mean;
+      mean += delta * nb / total;
+      m2 += m2_b + delta * delta * count * nb / total;
+      count = total;
+    }
+    result.mean[c] = mean;
+    result.variance[c] = count > 1 ? m2 / (count - 1) : 0.0;
+  }
+  return result;
+}
+
+}  // namespace kushner

@@ -1,0 +1,88 @@
+#pragma once
+// Small dense factorizations for one member's covariance: Cholesky, solves, inverse. Device-callable; they
+// report failure (not positive definite) through their return value, never by throwing.
+#include "kernels/math.hpp"
+#include "kernels/small_matrix.hpp"
+
+namespace kushner {
+
+/// Lower-triangular L with L L^T = A. Returns false (and leaves L partial) when a pivot is not positive
+/// or not finite: A is then not (numerically) positive definite.
+template <int N>
+KOKKOS_INLINE_FUNCTION bool cholesky(const Mat<N, N>& A, Mat<N, N>& L) {
+  L = Mat<N, N>::zero();
+  for (int j = 0; j < N; ++j) {
+    double d = A(j, j);
+    for (int k = 0; k < j; ++k) d -= L(j, k) * L(j, k);
+    if (!(d > 0.0) || !math::is_finite(d)) return false;
+    const double ljj = math::sqrt(d);
+    L(j, j) = ljj;
+    for (int i = j + 1; i < N; ++i) {
+      double s = A(i, j);
+      for (int k = 0; k < j; ++k) s -= L(i, k) * L(j, k);
+      L(i, j) = s / ljj;
+    }
+  }
+  return true;
+}
+
+/// Solves L L^T x = b for x, given the Cholesky factor L.
+template <int N>
+KOKKOS_INLINE_FUNCTION Vec<N> cholesky_solve(const Mat<N, N>& L, const Vec<N>& b) {
+  Vec<N> y;
+  for (int i = 0; i < N; ++i) {
+    double s = b[i];
+    for (int k = 0; k < i; ++k) s -= L(i, k) * y[k];
+    y[i] = s / L(i, i);
+  }
+  Vec<N> x;
+  for (int i = N - 1; i >= 0; --i) {
+    double s = y[i];
+    for (int k = i + 1; k < N; ++k) s -= L(k, i) * x[k];
+    x[i] = s / L(i, i);
+  }
+  return x;
+}
+
+/// A^{-1} from the Cholesky factor of A (symmetric by construction).
+template <int N>
+KOKKOS_INLINE_FUNCTION Mat<N, N> cholesky_inverse(const Mat<N, N>& L) {
+  Mat<N, N> inv;
+  for (int j = 0; j < N; ++j) {
+    Vec<N> e = Vec<N>::zero();
+    e[j] = 1.0;
+    const Vec<N> col = cholesky_solve(L, e);
+    for (int i = 0; i < N; ++i) inv(i, j) = col[i];
+  }
+  return symmetrize(inv);
+}
+
+/// x^T A^{-1} x from the Cholesky factor of A: |L^{-1} x|^2.
+template <int N>
+KOKKOS_INLINE_FUNCTION double cholesky_quadratic_form(const Mat<N, N>& L, const Vec<N>& x) {
+  double s = 0.0;
+  Vec<N> y;
+  for (int i = 0; i < N; ++i) {
+    double t = x[i];
+    for (int k = 0; k < i; ++k) t -= L(i, k) * y[k];
+    y[i] = t / L(i, i);
+    s += y[i] * y[i];
+  }
+  return s;
+}
+
+template <int N>
+KOKKOS_INLINE_FUNCTION bool all_finite(const Vec<N>& x) {
+  for (int i = 0; i < N; ++i)
+    if (!math::is_finite(x[i])) return false;
+  return true;
+}
+template <int R, int C>
+KOKKOS_INLINE_FUNCTION bool all_finite(const Mat<R, C>& m) {
+  for (int i = 0; i < R; ++i)
+    for (int j = 0; j < C; ++j)
+      if (!math::is_finite(m(i, j))) return false;
+  return true;
+}
+
+}  // namespace kushner

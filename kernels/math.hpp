@@ -1,0 +1,51 @@
+#pragma once
+// The one place where Kokkos version differences in math live: Kokkos 3.4 keeps its device-callable math
+// functions in Kokkos::Experimental, Kokkos 4 in Kokkos.
+#include <Kokkos_Core.hpp>
+
+#include <cstdint>
+#include <cstring>
+
+namespace kushner::math {
+
+#if KOKKOS_VERSION >= 40000
+namespace impl = ::Kokkos;
+#else
+namespace impl = ::Kokkos::Experimental;
+#endif
+
+using impl::atan;
+using impl::atan2;
+using impl::cos;
+using impl::cosh;
+using impl::exp;
+using impl::expm1;
+using impl::fabs;
+using impl::log;
+using impl::log1p;
+using impl::pow;
+using impl::sin;
+using impl::sinh;
+using impl::sqrt;
+using impl::tan;
+using impl::tanh;
+
+constexpr double pi = 3.14159265358979323846;
+
+/// True unless v is NaN or +-Inf. Tests the exponent bits, so it stays correct under -ffinite-math-only
+/// (implied by -ffast-math), where std::isfinite folds to a constant.
+KOKKOS_INLINE_FUNCTION bool is_finite(double v) {
+  std::uint64_t bits;
+  std::memcpy(&bits, &v, sizeof bits);
+  return (bits & 0x7ff0000000000000ull) != 0x7ff0000000000000ull;
+}
+
+KOKKOS_INLINE_FUNCTION double square(double v) { return v * v; }
+
+/// log(cosh(x)) without overflow for large |x|.
+KOKKOS_INLINE_FUNCTION double log_cosh(double x) {
+  const double a = fabs(x);
+  return a + log1p(exp(-2.0 * a)) - 0.69314718055994530942;
+}
+
+}  // namespace kushner::math

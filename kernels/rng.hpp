@@ -1,0 +1,100 @@
+#pragma once
+// Counter-based random numbers: Philox4x32-10 (Random123). Every draw is a pure function of
+// (seed, stream, member, particle, step, draw), so a run gives the same numbers on any number of threads,
+// on CPU or GPU, and in any order of evaluation.
+//
+//   key     = {seed, stream}                    -- distinct streams are distinct Philox keys: never overlap
+//   counter = {member, particle, step, draw}    -- draw counts Philox blocks within one (member, particle, step)
+//
+// Normals: each Philox block (4 x 32 bits) gives two 52-bit uniforms u1, u2 in (0, 1), and Box-Muller
+// turns them into two independent standard normals sqrt(-2 ln u1) (cos 2 pi u2, sin 2 pi u2). Box-Muller,
+// not a rejection method, so every member uses the same number of blocks per step and counters stay aligned.
+#include "kernels/math.hpp"
+#include "kernels/small_matrix.hpp"
+
+#include <Random123/philox.h>
+
+#include <cstdint>
+
+namespace kushner {
+
+/// Streams of random numbers; one Philox key each. Values are part of the file format of results
+/// (changing one changes every number a seed gives), so they never change.
+enum class Stream : std::uint32_t {
+  truth_initial = 1,      // initial states of the truths
+  process_noise = 2,      // dw of the truths
+  observation_noise = 3,  // dv of the observations
+  particle_initial = 4,   // initial particles
+  particle_noise = 5,     // dw of the particles
+  resampling = 6,         // uniforms of the resampling schemes
+  filter_initial = 7,     // randomized filter initial conditions
+};
+
+struct RngKey {
+  std::uint32_t seed;
+  Stream stream;
+};
+
+struct Counter {
+  std::uint32_t member, particle, step, draw;
+};
+
+KOKKOS_INLINE_FUNCTION r123array4x32 philox_block(const RngKey& key, const Counter& c) {
+  const r123array2x32 k = {{key.seed, static_cast<std::uint32_t>(key.stream)}};
+  const r123array4x32 ctr = {{c.member, c.particle, c.step, c.draw}};
+  return philox4x32(ctr, k);
+}
+
+/// Uniform in the open interval (0, 1) from two 32-bit words: the top 52 bits, offset by half a step, so
+/// that neither 0 (log in Box-Muller) nor 1 can occur: (k + 1/2) 2^-52, k = 0 .. 2^52 - 1.
+KOKKOS_INLINE_FUNCTION double uniform_open(std::uint32_t hi, std::uint32_t lo) {
+  const std::uint64_t bits = ((static_cast<std::uint64_t>(hi) << 32) | lo) >> 12;
+  return (static_cast<double>(bits) + 0.5) * 0x1.0p-52;
+}
+
+/// Two independent uniforms in (0, 1) from one Philox block.
+KOKKOS_INLINE_FUNCTION void uniform_pair(const RngKey& key, const Counter& c, double& u0, double& u1) {
+  const r123array4x32 r = philox_block(key, c);
+  u0 = uniform_open(r.v[0], r.v[1]);
+  u1 = uniform_open(r.v[2], r.v[3]);
+}
+
+/// Two independent standard normals from one Philox block (Box-Muller).
+KOKKOS_INLINE_FUNCTION void normal_pair(const RngKey& key, const Counter& c, double& z0, double& z1) {
+  double u0, u1;
+  uniform_pair(key, c, u0, u1);
+  const double radius = math::sqrt(-2.0 * math::log(u0));
+  const double angle = 2.0 * math::pi * u1;
+  z0 = radius * math::cos(angle);
+  z1 = radius * math::sin(angle);
+}
+
+/// N standard normals for one (member, particle, step): blocks draw = 0 .. ceil(N/2)-1.
+template <int N>
+KOKKOS_INLINE_FUNCTION Vec<N> normal_vector(const RngKey& key, std::uint32_t member, std::uint32_t particle,
+                                            std::uint32_t step) {
+  Vec<N> z;
+  for (int i = 0; i < N; i += 2) {
+    double z0, z1;
+    normal_pair(key, Counter{member, particle, step, static_cast<std::uint32_t>(i / 2)}, z0, z1);
+    z[i] = z0;
+    if (i + 1 < N) z[i + 1] = z1;
+  }
+  return z;
+}
+
+/// N uniforms in (0, 1) for one (member, particle, step): blocks draw = 0 .. ceil(N/2)-1.
+template <int N>
+KOKKOS_INLINE_FUNCTION Vec<N> uniform_vector(const RngKey& key, std::uint32_t member, std::uint32_t particle,
+                                             std::uint32_t step) {
+  Vec<N> u;
+  for (int i = 0; i < N; i += 2) {
+    double u0, u1;
+    uniform_pair(key, Counter{member, particle, step, static_cast<std::uint32_t>(i / 2)}, u0, u1);
+    u[i] = u0;
+    if (i + 1 < N) u[i + 1] = u1;
+  }
+  return u;
+}
+
+}  // namespace kushner

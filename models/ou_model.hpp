@@ -1,0 +1,40 @@
+#pragma once
+// Scalar Ornstein-Uhlenbeck process observed in white noise: the simplest model with exact moments,
+//   dx = -theta (x - mu) dt + sigma dw,   dy = x dt + r dv.
+// E[x(t)] = mu + (m0 - mu) e^{-theta t},  Var[x(t)] = P0 e^{-2 theta t} + sigma^2 (1 - e^{-2 theta t}) / (2 theta).
+#include "kernels/small_matrix.hpp"
+#include "models/initial_law.hpp"
+
+namespace kushner {
+
+struct OuModel : InitialLaw<1> {
+  static constexpr int state_dim = 1, obs_dim = 1, noise_dim = 1, control_dim = 0;
+  static constexpr bool discrete_time = false;
+  static constexpr const char* name = "ou";
+  static constexpr const char* description = "scalar Ornstein-Uhlenbeck: dx = -theta (x - mu) dt + sigma dw, dy = x dt + r dv";
+  using Control = Vec<control_dim>;
+
+  double theta = 1.0, mu = 0.0, sigma = 1.0, r = 0.5;
+
+  OuModel() { set_initial_law(Vec<1>{{1.0}}, Mat<1, 1>{{{0.0}}}); prior_cov = Mat<1, 1>{{{0.25}}}; }
+
+  template <class Visitor>
+  void parameters(Visitor&& v) {
+    v("theta", theta, "mean-reversion rate");
+    v("mu", mu, "long-run mean");
+    v("sigma", sigma, "process noise intensity");
+    v("r", r, "observation noise intensity");
+    initial_law_parameters(v);
+  }
+
+  KOKKOS_INLINE_FUNCTION Vec<1> drift(double, const Vec<1>& x, const Control&) const { return {{-theta * (x[0] - mu)}}; }
+  KOKKOS_INLINE_FUNCTION Mat<1, 1> drift_jacobian(double, const Vec<1>&, const Control&) const { return {{{-theta}}}; }
+  KOKKOS_INLINE_FUNCTION Mat<1, 1> drift_hessian(double, const Vec<1>&, const Control&, int) const { return {{{0.0}}}; }
+  KOKKOS_INLINE_FUNCTION Mat<1, 1> diffusion(double, const Vec<1>&) const { return {{{sigma}}}; }
+  KOKKOS_INLINE_FUNCTION Vec<1> observation(double, const Vec<1>& x) const { return x; }
+  KOKKOS_INLINE_FUNCTION Mat<1, 1> observation_jacobian(double, const Vec<1>&) const { return {{{1.0}}}; }
+  KOKKOS_INLINE_FUNCTION Mat<1, 1> observation_hessian(double, const Vec<1>&, int) const { return {{{0.0}}}; }
+  KOKKOS_INLINE_FUNCTION Mat<1, 1> observation_noise(double) const { return {{{r}}}; }
+};
+
+}  // namespace kushner

@@ -1,0 +1,103 @@
+#pragma once
+// The one place where a model name becomes a type. Commands call with_model(name, sets, f): the model is
+// built, its `--set key=value` assignments applied and checked, and f(model) called with the concrete type,
+// so everything downstream is dispatched at compile time.
+#include "kernels/errors.hpp"
+#include "models/clark_linear_model.hpp"
+#include "models/cubic_oscillator_model.hpp"
+#include "models/linear_model.hpp"
+#include "models/model_checks.hpp"
+#include "models/ou_model.hpp"
+#include "models/parameters.hpp"
+#include "models/sine_model.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+#include <tuple>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+namespace kushner {
+
+/// Every built-in model; a name may stand for several types told apart by `--set dim=N` (linear).
+using BuiltinModels = std::tuple<OuModel, SineModel, CubicOscillatorModel, LinearModel<1>, LinearModel<2>,
+                                 LinearModel<3>, ClarkLinearModel>;
+
+/// Models whose state dimension is chosen on the command line (`--set dim=N`), and its default.
+template <class Model>
+struct dimension_choice {
+  static constexpr bool selectable = false;
+};
+template <int N>
+struct dimension_choice<LinearModel<N>> {
+  static constexpr bool selectable = true;
+  static constexpr int default_dim = 2;
+};
+
+namespace detail {
+
+template <class Tuple, class F, std::size_t... I>
+void for_each_type(F&& f, std::index_sequence<I...>) {
+  (f(static_cast<std::tuple_element_t<I, Tuple>*>(nullptr)), ...);
+}
+
+/// Calls f(static_cast<Model*>(nullptr)) for every built-in model type.
+template <class F>
+void for_each_model_type(F&& f) {
+  detail::for_each_type<BuiltinModels>(f, std::make_index_sequence<std::tuple_size_v<BuiltinModels>>{});
+}
+
+}  // namespace detail
+
+/// Distinct model names, sorted, for messages and `kushner models`.
+std::vector<std::string> model_names();
+
+/// `kushner models`: names, descriptions, parameters with defaults and meanings.
+nlohmann::json describe_models();
+
+/// Builds the model called `name`, applies `sets` ("key=value"), validates it, and calls f(model).
+/// Throws InputError for an unknown model, an unknown key, a malformed value or an invalid configuration.
+template <class F>
+void with_model(const std::string& name, const std::vector<std::string>& sets, F&& f) {
+  std::vector<std::pair<std::string, std::string>> assignments;
+  int dim = 0;
+  for (const auto& s : sets) {
+    auto kv = split_assignment(s);
+    if (kv.first == "dim") {
+      const ParameterValue v = parse_parameter_value("dim", kv.second);
+      KUSHNER_INPUT_REQUIRE(v.rows == 1 && v.cols == 1 && v.values[0] == static_cast<int>(v.values[0]),
+                            "--set dim: expected an integer, got '" << kv.second << "'");
+      dim = static_cast<int>(v.values[0]);
+      continue;
+    }
+    assignments.push_back(std::move(kv));
+  }
+  bool name_known = false, called = false;
+  std::string dims;
+  detail::for_each_model_type([&](auto* tag) {
+    using Model = std::remove_pointer_t<decltype(tag)>;
+    if (called || name != Model::name) return;
+    name_known = true;
+    if constexpr (dimension_choice<Model>::selectable) {
+      dims += (dims.empty() ? "" : ", ") + std::to_string(Model::state_dim);
+      if ((dim == 0 ? dimension_choice<Model>::default_dim : dim) != Model::state_dim) return;
+    } else {
+      KUSHNER_INPUT_REQUIRE(dim == 0, "--set dim: model '" << name << "' has a fixed dimension "
+                                                             << Model::state_dim);
+    }
+    Model model;
+    apply_parameters(model, assignments);
+    validate_model(model);
+    called = true;
+    f(model);
+  });
+  if (called) return;
+  if (name_known) throw InputError("--set dim: model '" + name + "' supports dim " + dims + " (got " + std::to_string(dim) + ")");
+  std::string known;
+  for (const auto& n : model_names()) known += (known.empty() ? "" : ", ") + n;
+  throw InputError("--model: unknown model '" + name + "' (known: " + known + ")");
+}
+
+}  // namespace kushner

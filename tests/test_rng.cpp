@@ -1,0 +1,106 @@
+// Philox normals and uniforms: moments, Kolmogorov-Smirnov against the exact laws, and independence of streams.
+#include "kernels/rng.hpp"
+#include "tests/test_spaces.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <set>
+#include <vector>
+
+namespace kushner {
+namespace {
+
+constexpr std::uint32_t seed = 20261122;
+constexpr int num_draws = 1 << 20;  // ~1e6
+
+/// Draws normal_vector<2> for members 0 .. n/2-1 at one step, flattened.
+template <class ExecSpace>
+std::vector<double> draw_normals(Stream stream, int n, double scale = 1.0) {
+  Kokkos::View<double*, typename ExecSpace::memory_space> out("normals", n);
+  Kokkos::parallel_for(
+      "test::draw_normals", Kokkos::RangePolicy<ExecSpace>(0, n / 2), KOKKOS_LAMBDA(const int member) {
+        const Vec<2> z = normal_vector<2>(RngKey{seed, stream}, member, 3, 7);
+        out(2 * member) = scale * z[0];
+        out(2 * member + 1) = scale * z[1];
+      });
+  const auto host = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), out);
+  return std::vector<double>(host.data(), host.data() + n);
+}
+
+double standard_normal_cdf(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }
+
+/// Kolmogorov-Smirnov statistic of the sample against the standard normal.
+double ks_statistic(std::vector<double> x) {
+  std::sort(x.begin(), x.end());
+  const double n = static_cast<double>(x.size());
+  double d = 0.0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const double f = standard_normal_cdf(x[i]);
+    d = std::max({d, f - i / n, (i + 1) / n - f});
+  }
+  return d;
+}
+
+template <class ExecSpace>
+class PhiloxNormals : public ::testing::Test {};
+TYPED_TEST_SUITE(PhiloxNormals, test::ExecutionSpaces);
+
+TYPED_TEST(PhiloxNormals, MeanAndVarianceWithinFourStandardErrors) {
+  const auto z = draw_normals<TypeParam>(Stream::particle_noise, num_draws);
+  double mean = 0.0, m2 = 0.0;
+  for (double v : z) mean += v;
+  mean /= z.size();
+  for (double v : z) m2 += (v - mean) * (v - mean);
+  const double variance = m2 / (z.size() - 1);
+  const double n = static_cast<double>(z.size());
+  EXPECT_LT(std::abs(mean), 4.0 / std::sqrt(n)) << "mean " << mean;
+  EXPECT_LT(std::abs(variance - 1.0), 4.0 * std::sqrt(2.0 / n)) << "variance " << variance;
+}
+
+TYPED_TEST(PhiloxNormals, KolmogorovSmirnovAcceptsNormalAndRejectsScaledNormal) {
+  const double n = num_draws;
+  const double critical = 1.95 / std::sqrt(n);  // alpha = 0.001
+  const double d = ks_statistic(draw_normals<TypeParam>(Stream::process_noise, num_draws));
+  EXPECT_LT(d, critical) << "KS statistic " << d;
+  // Power: a 2% error in the standard deviation must be detected on the same draws.
+  const double d_scaled = ks_statistic(draw_normals<TypeParam>(Stream::process_noise, num_draws, 1.02));
+  EXPECT_GT(d_scaled, critical) << "KS statistic of scaled draws " << d_scaled;
+}
+
+TEST(PhiloxStreams, DistinctStreamsShareNoBlockAndAreUncorrelated) {
+  const std::vector<Stream> streams = {Stream::truth_initial,    Stream::process_noise, Stream::observation_noise,
+                                       Stream::particle_initial, Stream::particle_noise, Stream::resampling};
+  constexpr int blocks = 1 << 16;
+  std::set<std::uint64_t> seen;
+  for (Stream s : streams)
+    for (std::uint32_t m = 0; m < blocks; ++m) {
+      const r123array4x32 r = philox_block(RngKey{seed, s}, Counter{m, 0, 0, 0});
+      const std::uint64_t word = (static_cast<std::uint64_t>(r.v[0]) << 32) | r.v[1];
+      EXPECT_TRUE(seen.insert(word).second) << "block repeated in stream " << static_cast<int>(s) << " member " << m;
+    }
+  const auto a = draw_normals<Kokkos::DefaultHostExecutionSpace>(Stream::process_noise, num_draws);
+  const auto b = draw_normals<Kokkos::DefaultHostExecutionSpace>(Stream::observation_noise, num_draws);
+  double correlation = 0.0;
+  for (int i = 0; i < num_draws; ++i) correlation += a[i] * b[i];
+  correlation /= num_draws;
+  EXPECT_LT(std::abs(correlation), 4.0 / std::sqrt(static_cast<double>(num_draws))) << "correlation " << correlation;
+}
+
+TEST(PhiloxStreams, SameKeyAndCounterGiveSameNumbersOnEveryCall) {
+  double a0, a1, b0, b1;
+  normal_pair(RngKey{seed, Stream::process_noise}, Counter{5, 6, 7, 0}, a0, a1);
+  normal_pair(RngKey{seed, Stream::process_noise}, Counter{5, 6, 7, 0}, b0, b1);
+  EXPECT_EQ(a0, b0);
+  EXPECT_EQ(a1, b1);
+  normal_pair(RngKey{seed + 1, Stream::process_noise}, Counter{5, 6, 7, 0}, b0, b1);
+  EXPECT_NE(a0, b0);
+}
+
+TEST(UniformOpen, StaysInsideOpenInterval) {
+  EXPECT_GT(uniform_open(0, 0), 0.0);
+  EXPECT_LT(uniform_open(0xffffffffu, 0xffffffffu), 1.0);
+}
+
+}  // namespace
+}  // namespace kushner
