@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # kushner bootstrap: installs what the build needs, builds, and runs.
 #
-#   ./bootstrap.sh run [kushner args...]  build, then run the main job (defaults: `kushner compare`)
+#   ./bootstrap.sh run [kushner args...]  build, then run kushner (no arguments: the main job on defaults)
 #   ./bootstrap.sh test                   build, then run the whole test suite (ctest)
 #   ./bootstrap.sh build                  dependencies + Release build in build/
 #   ./bootstrap.sh deps                   dependencies only
@@ -112,7 +112,7 @@ case "$cmd" in
     cd "$build_dir" && OMP_PROC_BIND=false ctest --output-on-failure -j "$jobs" "$@" ;;
   run)
     install_packages; install_kokkos_source; configure_and_build >&2
-    if [ $# -eq 0 ]; then set -- compare; fi
+    if [ $# -eq 0 ]; then set -- simulate --model sine --out kushner-out; fi
     exec "$build_dir/kushner" "$@" ;;
   *) die "unknown command '$cmd' (known: run, test, build, deps, bundle)" ;;
 esac

@@ -34,6 +34,21 @@ assert backend_a != backend_b or backend_a["name"] == "openmp"
 PY
   done
   echo "ok: $name identical on omp1, omp2, serial"
+  if "$kushner" --version | grep -q 'available backends: cuda'; then
+    run_as "$name-cuda" KUSHNER_BACKEND=cuda -- "$@"
+    # FMA contraction and CUDA's libm round differently from glibc: equal to a stated relative tolerance.
+    python3 - "$work/$name-serial/timeseries.csv" "$work/$name-cuda/timeseries.csv" <<'PY' || fail "$name: cuda differs from serial"
+import sys
+rows = [[l.rstrip("\n").split(",") for l in open(p) if not l.startswith("#")] for p in sys.argv[1:3]]
+assert rows[0][0] == rows[1][0], "headers differ"
+worst = 0.0
+for ra, rb in zip(rows[0][1:], rows[1][1:]):
+    for a, b in zip(map(float, ra), map(float, rb)):
+        worst = max(worst, abs(a - b) / max(abs(a), abs(b), 1e-300))
+print("largest relative difference cuda vs serial: %.3g" % worst)
+sys.exit(worst > 1e-9)
+PY
+  fi
 }
 
 compare_runs sine --model sine --members 5000 --T 1 --dt 1e-2 --seed 7
