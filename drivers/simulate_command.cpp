@@ -14,12 +14,12 @@ std::string timeseries_csv(const MomentSeries& series, const RunContext& context
   std::string csv = csv_comment(context) + "t";
   for (int i = 1; i <= Model::state_dim; ++i)
     csv += ",mean_x" + std::to_string(i) + ",var_x" + std::to_string(i);
-  csv += "\n";
+  csv += ",diverged\n";
   for (std::size_t r = 0; r < series.times.size(); ++r) {
     csv += format_number(series.times[r]);
     for (int i = 0; i < Model::state_dim; ++i)
       csv += "," + format_number(series.moments[r].mean[i]) + "," + format_number(series.moments[r].variance[i]);
-    csv += "\n";
+    csv += "," + std::to_string(series.moments[r].non_finite) + "\n";
   }
   return csv;
 }
@@ -45,6 +45,7 @@ int run_simulate(const RunOptions& options, const RunContext& context) {
       summary["steps"] = grid.steps;
       summary["mean_final"] = series.moments.back().mean;
       summary["var_final"] = series.moments.back().variance;
+      summary["diverged"] = series.moments.back().non_finite;  // paths that escaped: left out of the moments
       summary["files"] = {"summary.json", "timeseries.csv"};
       out.write("timeseries.csv", timeseries_csv<Model>(series, context));
       out.write("summary.json", summary.dump(2) + "\n");

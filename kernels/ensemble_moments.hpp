@@ -2,19 +2,22 @@
 // Ensemble means and variances in a fixed summation order, so that results are bitwise the same on any
 // number of threads: each block of `block_size` consecutive members is reduced sequentially (Welford) by one
 // thread, and the host merges the blocks in order (Chan et al.). A Kokkos parallel_reduce would combine
-// partial sums in an order that depends on the thread count.
+// partial sums in an order that depends on the thread count. Members with a non-finite entry (a path that
+// escaped to infinity) are left out and counted.
 #include "kernels/bank.hpp"
+#include "kernels/math.hpp"
 
 #include <Kokkos_Core.hpp>
 
+#include <limits>
 #include <vector>
 
 namespace kushner {
 
 constexpr int moment_block_size = 256;
 
-/// blocks(b, 0) = member count of block b; blocks(b, 1 + c) = mean of column c; blocks(b, 1 + K + c) = sum of
-/// squared deviations of column c, over the members of block b (K = columns).
+/// blocks(b, 0) = finite members of block b; blocks(b, 1 + c) = mean of column c; blocks(b, 1 + K + c) = sum
+/// of squared deviations of column c, over the finite members of block b (K = columns).
 template <class MemSpace>
 struct BlockMoments {
   Kokkos::View<const double**, Kokkos::LayoutLeft, MemSpace> x;
@@ -25,23 +28,27 @@ struct BlockMoments {
     const int begin = b * moment_block_size;
     const int end = begin + moment_block_size < static_cast<int>(x.extent(0)) ? begin + moment_block_size
                                                                               : static_cast<int>(x.extent(0));
-    blocks(b, 0) = end - begin;
-    for (int c = 0; c < columns; ++c) {
-      double mean = 0.0, m2 = 0.0;
-      for (int m = begin; m < end; ++m) {
-        const double delta = x(m, c) - mean;
-        mean += delta / (m - begin + 1);
-        m2 += delta * (x(m, c) - mean);
+    for (int c = 0; c < columns; ++c) blocks(b, 1 + c) = blocks(b, 1 + columns + c) = 0.0;
+    int count = 0;
+    for (int m = begin; m < end; ++m) {
+      bool finite = true;
+      for (int c = 0; c < columns; ++c) finite = finite && math::is_finite(x(m, c));
+      if (!finite) continue;
+      ++count;
+      for (int c = 0; c < columns; ++c) {
+        const double delta = x(m, c) - blocks(b, 1 + c);
+        blocks(b, 1 + c) += delta / count;
+        blocks(b, 1 + columns + c) += delta * (x(m, c) - blocks(b, 1 + c));
       }
-      blocks(b, 1 + c) = mean;
-      blocks(b, 1 + columns + c) = m2;
     }
+    blocks(b, 0) = count;
   }
 };
 
 struct EnsembleMoments {
-  std::vector<double> mean;      // per column
-  std::vector<double> variance;  // per column, sample variance (divisor members - 1)
+  std::vector<double> mean;      // per column, over finite members
+  std::vector<double> variance;  // per column, sample variance (divisor finite members - 1)
+  long non_finite = 0;           // members left out
 };
 
 /// Mean and sample variance of every column of x(member, column) over members.
@@ -57,19 +64,21 @@ EnsembleMoments ensemble_moments(const ExecSpace& space, const View& x) {
   space.fence();
   const auto host = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), blocks);
 
-  EnsembleMoments result{std::vector<double>(columns, 0.0), std::vector<double>(columns, 0.0)};
+  EnsembleMoments result{std::vector<double>(columns, 0.0), std::vector<double>(columns, 0.0), members};
   for (int c = 0; c < columns; ++c) {
     double count = 0.0, mean = 0.0, m2 = 0.0;
     for (int b = 0; b < num_blocks; ++b) {
       const double nb = host(b, 0), mean_b = host(b, 1 + c), m2_b = host(b, 1 + columns + c);
+      if (nb == 0) continue;
       const double total = count + nb;
       const double delta = mean_b - mean;
       mean += delta * nb / total;
       m2 += m2_b + delta * delta * count * nb / total;
       count = total;
     }
-    result.mean[c] = mean;
-    result.variance[c] = count > 1 ? m2 / (count - 1) : 0.0;
+    result.mean[c] = count > 0 ? mean : std::numeric_limits<double>::quiet_NaN();
+    result.variance[c] = count > 1 ? m2 / (count - 1) : std::numeric_limits<double>::quiet_NaN();
+    result.non_finite = members - static_cast<long>(count);
   }
   return result;
 }

@@ -1,8 +1,12 @@
 #pragma once
 // Sunahara (1968) Example 2, seed 000 eqs. (6.12)-(6.13): a damped oscillator with a cubic spring,
 //   dx1 = x2 dt,  dx2 = (-x2 - x1 + x1^3 / 8) dt + q dw,  dy1 = x1 dt + r dv1,  dy2 = x2 dt + r dv2.
-// The paper starts the truth at x(0) = (15, 10) and the filters at 0 (Fig. 6); it gives neither q, r nor the
-// filters' initial covariance. Ours: q = 1, r = 0.5, prior_cov = diag(100, 100) (the initial error is (15, 10)).
+// The paper prints x(0) = (15, 10) for the truth and 0 for the filters (Fig. 6), but with this softening
+// spring (restoring force negative for |x1| > sqrt(8)) the noise-free path from (15, 10) escapes to infinity
+// at t ~ 0.34. We read a lost decimal point: the truth starts at (1.5, 1.0) (`--set x0_mean=15,10` gives the
+// printed start). The paper gives neither q, r nor the filters' initial covariance; ours: q = r = 0.5,
+// prior N(0, I). Even so, a few percent of noisy paths escape over long horizons: such members are counted
+// as diverged, not averaged in.
 #include "kernels/small_matrix.hpp"
 #include "models/initial_law.hpp"
 
@@ -16,13 +20,13 @@ struct CubicOscillatorModel : InitialLaw<2> {
       "Sunahara 1968 Example 2: dx1 = x2 dt, dx2 = (-x2 - x1 + x1^3/8) dt + q dw, dy = x dt + r dv";
   using Control = Vec<control_dim>;
 
-  double q = 1.0, r = 0.5;
+  double q = 0.5, r = 0.5;
 
   CubicOscillatorModel() {
-    x0_mean = Vec<2>{{15.0, 10.0}};
+    x0_mean = Vec<2>{{1.5, 1.0}};
     x0_cov = Mat<2, 2>::zero();
     prior_mean = Vec<2>::zero();
-    prior_cov = Mat<2, 2>::diagonal(100.0);
+    prior_cov = Mat<2, 2>::identity();
   }
 
   template <class Visitor>

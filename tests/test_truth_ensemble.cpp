@@ -157,8 +157,11 @@ TEST(EulerMaruyamaStep, SineStepMatchesHandComputation) {
     normal_pair(RngKey{seed, Stream::process_noise}, Counter{std::uint32_t(m), 0, 5, 0}, dw, unused);
     normal_pair(RngKey{seed, Stream::observation_noise}, Counter{std::uint32_t(m), 0, 5, 0}, dv, unused);
     const double x = x0(m, 0);
-    EXPECT_DOUBLE_EQ(x1(m, 0), x - std::sin(x) * dt + 0.7 * dw * std::sqrt(dt));
-    EXPECT_DOUBLE_EQ(dy(m, 0), x * dt + 0.3 * dv * std::sqrt(dt));
+    // Equal to rounding: a GPU contracts a*b+c into one FMA and has its own sin, so allow 1e-13 of the
+    // terms' magnitude (a wrong draw or step would be off by the noise term itself, ~1e-2).
+    const double dx_noise = 0.7 * dw * std::sqrt(dt), dy_noise = 0.3 * dv * std::sqrt(dt);
+    EXPECT_NEAR(x1(m, 0), x - std::sin(x) * dt + dx_noise, 1e-13 * (std::abs(x) + std::abs(dx_noise)));
+    EXPECT_NEAR(dy(m, 0), x * dt + dy_noise, 1e-13 * (std::abs(x * dt) + std::abs(dy_noise)));
   }
 }
 
