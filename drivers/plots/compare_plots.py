@@ -1,0 +1,213 @@
+#!/usr/bin/env python3
+"""Plots and report for a `kushner compare` run directory.
+
+usage: compare_plots.py DIR
+
+Reads DIR/summary.json, DIR/timeseries.csv, DIR/trajectories.csv and (1-D models) DIR/density.csv, as written
+by `kushner compare`, and writes PNG and SVG figures plus DIR/report.md. Figures are written through a
+temporary name and renamed, like every kushner output.
+
+  estimates.{png,svg}  one member: truth, each filter's estimate with its +-2 sigma band, the particle mean
+                       and its 5-95% band (first state component; one panel per component up to 3)
+  errors.{png,svg}     RMS error to the truth against time, per filter (and to the particle mean, dashed)
+  rmse_ref.{png,svg}   bar chart of rmse_ref per filter with +-2 standard-error bars
+  density.{png,svg}    (1-D models) the particle density at chosen times with each filter's Gaussian
+"""
+import csv
+import json
+import math
+import os
+import sys
+from collections import defaultdict
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+COLORS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f",
+          "#bcbd22", "#17becf", "#393b79", "#637939"]
+
+
+def read_csv(path):
+    """Rows of a CSV file as dicts, skipping the leading '#' comment line."""
+    with open(path, newline="") as f:
+        return list(csv.DictReader(line for line in f if not line.startswith("#")))
+
+
+def save(fig, directory, name):
+    for ext in ("png", "svg"):
+        tmp = os.path.join(directory, f"{name}.tmp.{ext}")
+        fig.savefig(tmp, dpi=130, bbox_inches="tight")
+        os.replace(tmp, os.path.join(directory, f"{name}.{ext}"))
+    plt.close(fig)
+
+
+def color_of(names):
+    return {n: COLORS[i % len(COLORS)] for i, n in enumerate(names)}
+
+
+def plot_estimates(directory, summary, rows, colors):
+    """Truth, estimates with +-2 sigma bands and the particle band, for the first member in trajectories.csv."""
+    member = rows[0]["member"]
+    rows = [r for r in rows if r["member"] == member]
+    components = sorted({int(r["component"]) for r in rows})[:3]
+    fig, axes = plt.subplots(len(components), 1, figsize=(9, 3.2 * len(components)), squeeze=False, sharex=True)
+    for ax, c in zip(axes[:, 0], components):
+        by_series = defaultdict(list)
+        for r in rows:
+            if int(r["component"]) == c:
+                by_series[r["series"]].append(r)
+        truth = by_series.pop("truth", [])
+        reference = by_series.pop("PF", None)
+        if reference:
+            t = [float(r["t"]) for r in reference]
+            ax.fill_between(t, [float(r["lower"]) for r in reference], [float(r["upper"]) for r in reference],
+                            color="0.85", label="particle filter 5-95%")
+            ax.plot(t, [float(r["estimate"]) for r in reference], color="0.35", lw=1.2, label="particle mean")
+        for name, series in by_series.items():
+            t = [float(r["t"]) for r in series]
+            ax.plot(t, [float(r["estimate"]) for r in series], color=colors.get(name), lw=1.0, label=name)
+            ax.fill_between(t, [float(r["lower"]) for r in series], [float(r["upper"]) for r in series],
+                            color=colors.get(name), alpha=0.08)
+        if truth:
+            ax.plot([float(r["t"]) for r in truth], [float(r["estimate"]) for r in truth], color="k", lw=1.6,
+                    ls=":", label="truth")
+        ax.set_ylabel(f"x{c}")
+        ax.grid(alpha=0.3)
+    axes[0, 0].set_title(f"{summary['model']['name']}: member {member}, estimates with +-2 sigma bands")
+    axes[-1, 0].set_xlabel("t")
+    axes[0, 0].legend(fontsize=7, ncol=4, loc="upper right")
+    save(fig, directory, "estimates")
+
+
+def plot_errors(directory, summary, rows, colors):
+    """Ensemble RMS error to the truth (solid) and to the particle mean (dashed) against time."""
+    by_filter = defaultdict(list)
+    for r in rows:
+        by_filter[r["filter"]].append(r)
+    fig, ax = plt.subplots(figsize=(9, 4.2))
+    for name, series in by_filter.items():
+        t = [float(r["t"]) for r in series]
+        ax.plot(t, [float(r["rmse_truth"]) for r in series], color=colors.get(name, "0.3"), lw=1.2, label=name)
+        if "rmse_ref" in series[0] and series[0]["rmse_ref"] not in ("", "nan"):
+            ax.plot(t, [float(r["rmse_ref"]) for r in series], color=colors.get(name, "0.3"), lw=0.9, ls="--")
+    ax.set_yscale("log")
+    ax.set_xlabel("t")
+    ax.set_ylabel("RMS error over members")
+    ax.set_title("error to the truth (solid) and to the particle-filter mean (dashed)")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=8, ncol=4)
+    save(fig, directory, "errors")
+
+
+def plot_rmse_ref(directory, summary, colors):
+    filters = [(n, f) for n, f in summary["filters"].items() if f.get("rmse_ref") is not None and n != "PF"]
+    if not filters:
+        return False
+    filters.sort(key=lambda nf: nf[1]["rmse_ref"])
+    fig, ax = plt.subplots(figsize=(max(5, 0.9 * len(filters) + 2), 4))
+    names = [n for n, _ in filters]
+    ax.bar(names, [f["rmse_ref"] for _, f in filters], yerr=[2 * f.get("rmse_ref_se", 0.0) for _, f in filters],
+           color=[colors.get(n) for n in names], capsize=4)
+    ax.set_ylabel("RMS distance to particle mean")
+    ax.set_title("approximation error against the true conditional mean (+-2 SE)")
+    ax.grid(alpha=0.3, axis="y")
+    save(fig, directory, "rmse_ref")
+    return True
+
+
+def plot_density(directory, summary, rows, colors):
+    times = sorted({float(r["t"]) for r in rows})
+    fig, axes = plt.subplots(1, len(times), figsize=(4 * len(times), 3.4), squeeze=False)
+    for ax, t in zip(axes[0], times):
+        by_series = defaultdict(list)
+        for r in rows:
+            if float(r["t"]) == t:
+                by_series[r["series"]].append((float(r["x"]), float(r["density"])))
+        pf = by_series.pop("PF", [])
+        if pf:
+            xs, ds = zip(*pf)
+            width = (xs[1] - xs[0]) if len(xs) > 1 else 1.0
+            ax.bar(xs, ds, width=width, color="0.8", label="particle filter")
+        for name, points in by_series.items():
+            if name == "truth":
+                ax.axvline(points[0][0], color="k", ls=":", label="truth")
+                continue
+            xs, ds = zip(*points)
+            ax.plot(xs, ds, color=colors.get(name), lw=1.1, label=name)
+        ax.set_title(f"t = {t:g}")
+        ax.set_xlabel("x")
+    axes[0][0].set_ylabel("conditional density")
+    axes[0][0].legend(fontsize=7)
+    save(fig, directory, "density")
+
+
+def fmt(value, se=None):
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return "–"
+    return f"{value:.4g} ± {se:.2g}" if se is not None else f"{value:.4g}"
+
+
+def write_report(directory, summary, figures):
+    backend = summary.get("backend", {})
+    where = backend.get("device") or f"{backend.get('threads', '?')} threads"
+    lines = [f"# kushner compare: {summary['model']['name']}", "",
+             f"- command: `{summary['command']}`",
+             f"- seed {summary['seed']}, kushner {summary['version']} (git {summary.get('git', '?')}), "
+             f"backend {backend.get('name', '?')} ({where}), Kokkos {backend.get('kokkos', '?')}",
+             f"- members {summary['members']}, T = {summary['T']}, dt = {summary['dt']}"]
+    ref = summary.get("reference")
+    if ref:
+        lines.append(f"- reference: {ref.get('kind')} with {ref.get('particles')} particles per member, "
+                     f"mean ESS {fmt(ref.get('mean_ess'))}, resampling events {ref.get('resamples')}")
+    lines += ["", "## Metrics", "",
+              "`rmse_ref`: RMS distance to the particle-filter posterior mean (the approximation error against the "
+              "true conditional density); `rmse_truth`: RMS error to the simulated truth; `nees`: mean normalized "
+              "estimation error squared (the state dimension when the filter's covariance is honest); `diverged`: "
+              "members whose covariance lost positive definiteness or whose values became non-finite. "
+              "± one Monte Carlo standard error over members.", "",
+              "| filter | rmse_ref | rmse_truth | nees | diverged |", "|---|---|---|---|---|"]
+    rows = sorted(summary["filters"].items(),
+                  key=lambda nf: (nf[1].get("rmse_ref") is None, nf[1].get("rmse_ref") or 0.0))
+    for name, f in rows:
+        lines.append(f"| {name} | {fmt(f.get('rmse_ref'), f.get('rmse_ref_se'))} | "
+                     f"{fmt(f.get('rmse_truth'), f.get('rmse_truth_se'))} | {fmt(f.get('nees'), f.get('nees_se'))} | "
+                     f"{f.get('diverged', 0)} |")
+    lines += ["", "## Figures", ""]
+    captions = {"estimates": "One member: truth, estimates with ±2σ bands, particle mean with its 5–95% band.",
+                "errors": "RMS error over members against time: to the truth (solid), to the particle mean (dashed).",
+                "rmse_ref": "Approximation error per filter, with ±2 standard-error bars.",
+                "density": "Particle density (histogram) against each filter's Gaussian, one member."}
+    for name in figures:
+        lines += [f"![{name}]({name}.png)", "", captions[name], ""]
+    tmp = os.path.join(directory, "report.md.tmp")
+    with open(tmp, "w") as f:
+        f.write("\n".join(lines) + "\n")
+    os.replace(tmp, os.path.join(directory, "report.md"))
+
+
+def main():
+    if len(sys.argv) != 2:
+        sys.exit(__doc__)
+    directory = sys.argv[1]
+    summary = json.load(open(os.path.join(directory, "summary.json")))
+    colors = color_of([n for n in summary["filters"] if n != "PF"])
+    figures = []
+    trajectories = os.path.join(directory, "trajectories.csv")
+    if os.path.exists(trajectories):
+        plot_estimates(directory, summary, read_csv(trajectories), colors)
+        figures.append("estimates")
+    plot_errors(directory, summary, read_csv(os.path.join(directory, "timeseries.csv")), colors)
+    figures.append("errors")
+    if plot_rmse_ref(directory, summary, colors):
+        figures.append("rmse_ref")
+    density = os.path.join(directory, "density.csv")
+    if os.path.exists(density):
+        plot_density(directory, summary, read_csv(density), colors)
+        figures.append("density")
+    write_report(directory, summary, figures)
+
+
+if __name__ == "__main__":
+    main()
