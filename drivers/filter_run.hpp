@@ -1,0 +1,116 @@
+#pragma once
+// A whole filter run over a time grid: the bank of truths and filters stepped from 0 to T, metrics collected
+// at the grid's output times and over the run. ASRE iterates over the whole horizon, so when it is selected
+// a first pass runs the truths with ASRE alone to find, per member, the first iterate whose estimate
+// trajectory changed less than the tolerance; the main pass then reports that iterate. Shared by
+// `kushner filter`, the tests and the benchmarks.
+#include "drivers/filter_bank.hpp"
+#include "drivers/progress.hpp"
+#include "drivers/reference_mean.hpp"
+#include "drivers/run_options.hpp"
+
+#include <Kokkos_Core.hpp>
+
+#include <algorithm>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace kushner {
+
+/// ASRE iterations used, over the members (seed 001 Theorem 2 with a tolerance-based stop).
+struct AsreIterations {
+  std::vector<int> per_member;  // the iterate reported (0 = the frozen-coefficient Kalman-Bucy run)
+  double mean = 0.0;
+  int min = 0, max = 0;
+  long not_converged = 0;  // members that reached max_iterations (or diverged) without meeting the tolerance
+};
+
+struct FilterReport {
+  std::vector<std::string> filters;                   // report order
+  std::vector<double> times;                          // output times
+  std::vector<std::vector<FilterSnapshot>> series;    // [time][filter]
+  std::vector<FilterScores> scores;                   // [filter], over the whole run
+  long truths_escaped = 0;                            // members left out of every metric
+  bool has_reference = false;
+  AsreIterations asre;                                // when ASRE is among the filters
+};
+
+/// Per member, the first ASRE iterate i >= 1 with max_t |m^[i] - m^[i-1]| < tolerance (else max_iterations),
+/// from a pass of the truths with ASRE alone, iterated max_iterations times.
+template <class ExecSpace, class Model>
+AsreIterations asre_iterations(const ExecSpace& space, const Model& truth_model, const Model& filter_model,
+                               long members, std::uint32_t seed, const TimeGrid& grid, FilterConfig config,
+                               Progress* progress) {
+  config.asre_iterations.clear();
+  FilterBank<ExecSpace, Model> bank(space, truth_model, filter_model, members, seed, {"ASRE"}, config);
+  for (long k = 0; k < grid.steps; ++k) {
+    bank.step(k, grid.dt, false);
+    if (progress) progress->update(k + 1);
+  }
+  space.fence();
+  AsreIterations result;
+  result.per_member.assign(members, config.asre_max_iterations);
+  bank.with_slot("ASRE", [&](const auto& slot) {
+    const auto change = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), slot.filter.change);
+    const auto status = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), slot.status);
+    for (long member = 0; member < members; ++member) {
+      bool converged = false;
+      for (int i = 1; i <= config.asre_max_iterations && status(member) == Status::ok; ++i)
+        if (change(member, i) < config.asre_tolerance) {
+          result.per_member[member] = i;
+          converged = true;
+          break;
+        }
+      if (!converged) ++result.not_converged;
+    }
+  });
+  result.min = *std::min_element(result.per_member.begin(), result.per_member.end());
+  result.max = *std::max_element(result.per_member.begin(), result.per_member.end());
+  double sum = 0.0;
+  for (int i : result.per_member) sum += i;
+  result.mean = sum / members;
+  return result;
+}
+
+/// Runs the filters `filters` (from select_filters<Model>) over `grid`. The truths follow truth_model, the
+/// filters filter_model. With a `reference`, every filter is also scored against its mean (rmse_ref).
+/// `progress` counts steps of both passes when ASRE is selected (2 * grid.steps), else grid.steps.
+template <class ExecSpace, class Model>
+FilterReport run_filters(const ExecSpace& space, const Model& truth_model, const Model& filter_model, long members,
+                         std::uint32_t seed, const TimeGrid& grid, const std::vector<std::string>& filters,
+                         FilterConfig config, ReferenceMean<typename ExecSpace::memory_space>* reference = nullptr,
+                         Progress* progress = nullptr) {
+  FilterReport report;
+  report.filters = filters;
+  report.has_reference = reference != nullptr;
+  if (std::find(filters.begin(), filters.end(), "ASRE") != filters.end()) {
+    report.asre = asre_iterations(space, truth_model, filter_model, members, seed, grid, config, progress);
+    config.asre_iterations = report.asre.per_member;
+  }
+  FilterBank<ExecSpace, Model> bank(space, truth_model, filter_model, members, seed, filters, config);
+  bank.set_reference(reference);
+  auto record = [&](double t) {
+    report.times.push_back(t);
+    report.series.emplace_back();
+    for (const auto& name : filters) report.series.back().push_back(bank.snapshot(name));
+  };
+  record(0.0);
+  std::size_t next_output = 1;
+  const long progress_base = report.asre.per_member.empty() ? 0 : grid.steps;  // after ASRE's first pass
+  for (long k = 0; k < grid.steps; ++k) {
+    const bool output = next_output < grid.output_steps.size() && grid.output_steps[next_output] == k + 1;
+    bank.step(k, grid.dt, output);
+    if (output) {
+      record((k + 1) * grid.dt);
+      ++next_output;
+    }
+    if (progress) progress->update(progress_base + k + 1);
+  }
+  space.fence();
+  for (const auto& name : filters) report.scores.push_back(bank.scores(name, grid.steps + 1));
+  report.truths_escaped = bank.truths_escaped();
+  return report;
+}
+
+}  // namespace kushner
