@@ -130,6 +130,12 @@ class FilterBank {
     KUSHNER_REQUIRE(found, "filter '" << name << "' is not in this bank");
   }
 
+  /// The slot of filter type Filter (one the model supports).
+  template <template <class, class> class Filter>
+  const FilterSlot<Filter<Model, MemSpace>, MemSpace>& slot() const {
+    return static_cast<const FilterSlot<Filter<Model, MemSpace>, MemSpace>&>(slots_);
+  }
+
   /// Metrics of filter `name` at the latest output time.
   FilterSnapshot snapshot(const std::string& name) const {
     FilterSnapshot s;

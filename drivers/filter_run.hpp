@@ -51,7 +51,8 @@ AsreIterations asre_iterations(const ExecSpace& space, const Model& truth_model,
   space.fence();
   AsreIterations result;
   result.per_member.assign(members, config.asre_max_iterations);
-  bank.with_slot("ASRE", [&](const auto& slot) {
+  if constexpr (AsreFilter<Model, typename ExecSpace::memory_space>::unsupported == nullptr) {
+    const auto& slot = bank.template slot<AsreFilter>();
     const auto change = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), slot.filter.change);
     const auto status = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), slot.status);
     for (long member = 0; member < members; ++member) {
@@ -64,7 +65,7 @@ AsreIterations asre_iterations(const ExecSpace& space, const Model& truth_model,
         }
       if (!converged) ++result.not_converged;
     }
-  });
+  }
   result.min = *std::min_element(result.per_member.begin(), result.per_member.end());
   result.max = *std::max_element(result.per_member.begin(), result.per_member.end());
   double sum = 0.0;

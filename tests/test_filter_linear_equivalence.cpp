@@ -6,11 +6,10 @@
 #include "drivers/filter_bank.hpp"
 #include "drivers/filter_selection.hpp"
 #include "models/linear_model.hpp"
+#include "tests/filter_test_helpers.hpp"
 
 #include <gtest/gtest.h>
 
-#include <algorithm>
-#include <cmath>
 
 namespace kushner {
 namespace {
@@ -39,23 +38,6 @@ LinearModel<3> linear_3d() {
   return model;
 }
 
-/// max over members of |a - b|_inf / |b|_inf, row by row of two (member, k) views copied to the host.
-template <class View>
-double largest_relative_difference(const View& a, const View& b) {
-  const auto ha = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), a);
-  const auto hb = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), b);
-  double worst = 0.0;
-  for (std::size_t member = 0; member < ha.extent(0); ++member) {
-    double diff = 0.0, scale = 0.0;
-    for (std::size_t k = 0; k < ha.extent(1); ++k) {
-      diff = std::max(diff, std::abs(ha(member, k) - hb(member, k)));
-      scale = std::max(scale, std::abs(hb(member, k)));
-    }
-    worst = std::max(worst, diff / scale);
-  }
-  return worst;
-}
-
 template <class Model>
 void expect_every_filter_equals_kalman_bucy(const Model& model, Expectations qlf_expectations) {
   using Space = Kokkos::DefaultExecutionSpace;
@@ -72,8 +54,8 @@ void expect_every_filter_equals_kalman_bucy(const Model& model, Expectations qlf
       for (const auto& name : filters) {
         if (name == "KB") continue;
         bank.with_slot(name, [&](const auto& slot) {
-          ASSERT_LT(largest_relative_difference(slot.m, kb.m), tolerance) << name << " m, step " << k;
-          ASSERT_LT(largest_relative_difference(slot.P, kb.P), tolerance) << name << " P, step " << k;
+          ASSERT_LT(test::largest_relative_difference(slot.m, kb.m), tolerance) << name << " m, step " << k;
+          ASSERT_LT(test::largest_relative_difference(slot.P, kb.P), tolerance) << name << " P, step " << k;
         });
       }
     });
@@ -103,7 +85,7 @@ TEST(FilterBankOnLinearModel, DifferentModelIsDetected) {
     b.step(k, dt, false);
   }
   a.with_slot("KB", [&](const auto& sa) {
-    b.with_slot("KB", [&](const auto& sb) { EXPECT_GT(largest_relative_difference(sb.m, sa.m), 100 * tolerance); });
+    b.with_slot("KB", [&](const auto& sb) { EXPECT_GT(test::largest_relative_difference(sb.m, sa.m), 100 * tolerance); });
   });
 }
 

@@ -12,6 +12,7 @@
 // One bank pass with `max_iterations` iterates records, per member and iterate, the largest change
 // max_t |m^[i](t) - m^[i-1](t)|_inf (`change`); drivers/filter_run.hpp picks each member's first iterate
 // below the tolerance and runs the bank again reporting that iterate.
+#include "kernels/bank.hpp"
 #include "kernels/errors.hpp"
 #include "kernels/filters/filter_config.hpp"
 #include "kernels/filters/jacobian_linearization.hpp"

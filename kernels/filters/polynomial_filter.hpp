@@ -17,7 +17,9 @@ namespace kushner {
 template <class Model, int Degree>
 constexpr const char* polynomial_filter_unsupported() {
   using T = ModelTraits<Model>;
-  if (!T::power_polynomial) return "drift is not polynomial in componentwise powers";
+  if (!T::power_polynomial)
+    return T::quadratic_polynomial ? "drift has cross terms x_i x_j, not componentwise powers (BILIN handles them)"
+                                   : "drift is not polynomial";
   if (T::power_degree() > Degree) return Degree == 3 ? "drift has degree above 3" : "drift has degree above 4";
   if (!T::linear_observation) return "observation is not linear";
   return nullptr;
