@@ -29,7 +29,9 @@ struct Estimate {
 /// One filter at one output time.
 struct FilterSnapshot {
   double rmse_truth = 0.0;  // sqrt of the mean over scored members of |m - x|^2
+  double rmse_truth_se = 0.0;
   double nees = 0.0;        // mean over members with positive definite P
+  double nees_se = 0.0;
   double rmse_ref = 0.0;    // against the reference mean, when there is one
   long diverged = 0;        // members whose filter has diverged by now
 };
@@ -140,10 +142,13 @@ class FilterBank {
   FilterSnapshot snapshot(const std::string& name) const {
     FilterSnapshot s;
     with_slot(name, [&](const auto& slot) {
-      s.rmse_truth = std::sqrt(column_moments(slot.snapshot, snapshot_squared_error).mean[0]);
-      s.nees = column_moments(slot.snapshot, snapshot_nees).mean[0];
-      s.rmse_ref = reference_ ? std::sqrt(column_moments(slot.snapshot, snapshot_reference_squared_error).mean[0])
-                              : std::nan("");
+      const Estimate rmse = root_mean(slot.snapshot, snapshot_squared_error);
+      const Estimate nees = mean(slot.snapshot, snapshot_nees);
+      s.rmse_truth = rmse.value;
+      s.rmse_truth_se = rmse.standard_error;
+      s.nees = nees.value;
+      s.nees_se = nees.standard_error;
+      s.rmse_ref = reference_ ? root_mean(slot.snapshot, snapshot_reference_squared_error).value : std::nan("");
       s.diverged = count_status(space_, slot.status, Status::not_positive_definite) +
                    count_status(space_, slot.status, Status::non_finite);
     });
@@ -209,10 +214,6 @@ class FilterBank {
   template <class View>
   EnsembleMoments column_moments(const View& x, int column) const {
     return ensemble_moments(space_, Kokkos::subview(x, Kokkos::ALL, std::make_pair(column, column + 1)));
-  }
-  template <class View>
-  double column_mean(const View& x, int column) const {
-    return column_moments(x, column).mean[0];
   }
   template <class View>
   Estimate mean(const View& x, int column) const {

@@ -15,13 +15,14 @@ namespace kushner {
 namespace detail {
 
 inline std::string filter_timeseries_csv(const FilterReport& report, const RunContext& context) {
-  std::string csv = csv_comment(context) + "t,filter,rmse_truth,nees,diverged";
+  std::string csv = csv_comment(context) + "t,filter,rmse_truth,rmse_truth_se,nees,nees_se,diverged";
   csv += report.has_reference ? ",rmse_ref\n" : "\n";
   for (std::size_t r = 0; r < report.times.size(); ++r)
     for (std::size_t f = 0; f < report.filters.size(); ++f) {
       const FilterSnapshot& s = report.series[r][f];
       csv += format_number(report.times[r]) + "," + report.filters[f] + "," + format_number(s.rmse_truth) + "," +
-             format_number(s.nees) + "," + std::to_string(s.diverged);
+             format_number(s.rmse_truth_se) + "," + format_number(s.nees) + "," + format_number(s.nees_se) + "," +
+             std::to_string(s.diverged);
       csv += report.has_reference ? "," + format_number(s.rmse_ref) + "\n" : "\n";
     }
   return csv;
@@ -74,7 +75,7 @@ void run_filter_command(const Model& model, const FilterOptions& options, const 
   KokkosSession kokkos;
   with_backend(context.backend, [&](const auto& space) {
     const bool asre = std::find(filters.begin(), filters.end(), "ASRE") != filters.end();
-    Progress progress("filter", grid.steps * (asre ? 2 : 1), !options.run.quiet);
+    Progress progress("filter", grid.steps * (asre ? 3 : 1), !options.run.quiet);
     const FilterReport report = run_filters(space, model, model, options.run.members,
                                             static_cast<std::uint32_t>(options.run.seed), grid, filters, config,
                                             nullptr, &progress);

@@ -36,35 +36,59 @@ struct FilterReport {
   AsreIterations asre;                                // when ASRE is among the filters
 };
 
-/// Per member, the first ASRE iterate i >= 1 with max_t |m^[i] - m^[i-1]| < tolerance (else max_iterations),
-/// from a pass of the truths with ASRE alone, iterated max_iterations times.
+namespace detail {
+
+/// One pass of the truths with ASRE alone, member `i` iterated iterations[i] times; marks in `first` each
+/// member's first iterate j >= 1 (among those run) with max_t |m^[j] - m^[j-1]| < tolerance.
 template <class ExecSpace, class Model>
-AsreIterations asre_iterations(const ExecSpace& space, const Model& truth_model, const Model& filter_model,
-                               long members, std::uint32_t seed, const TimeGrid& grid, FilterConfig config,
-                               Progress* progress) {
-  config.asre_iterations.clear();
+void asre_pass(const ExecSpace& space, const Model& truth_model, const Model& filter_model, long members,
+               std::uint32_t seed, const TimeGrid& grid, FilterConfig config, const std::vector<int>& iterations,
+               std::vector<int>& first, Progress* progress, long progress_base) {
+  config.asre_iterations = iterations;
   FilterBank<ExecSpace, Model> bank(space, truth_model, filter_model, members, seed, {"ASRE"}, config);
   for (long k = 0; k < grid.steps; ++k) {
     bank.step(k, grid.dt, false);
-    if (progress) progress->update(k + 1);
+    if (progress) progress->update(progress_base + k + 1);
   }
   space.fence();
-  AsreIterations result;
-  result.per_member.assign(members, config.asre_max_iterations);
   if constexpr (AsreFilter<Model, typename ExecSpace::memory_space>::unsupported == nullptr) {
     const auto& slot = bank.template slot<AsreFilter>();
     const auto change = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), slot.filter.change);
     const auto status = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), slot.status);
-    for (long member = 0; member < members; ++member) {
-      bool converged = false;
-      for (int i = 1; i <= config.asre_max_iterations && status(member) == Status::ok; ++i)
+    for (long member = 0; member < members; ++member)
+      for (int i = 1; i <= iterations[member] && status(member) == Status::ok; ++i)
         if (change(member, i) < config.asre_tolerance) {
-          result.per_member[member] = i;
-          converged = true;
+          first[member] = i;
           break;
         }
-      if (!converged) ++result.not_converged;
-    }
+  }
+}
+
+}  // namespace detail
+
+/// Per member, the first ASRE iterate i >= 1 with max_t |m^[i] - m^[i-1]| < tolerance (else max_iterations).
+/// Iterates do not depend on how many follow them, so this runs the truths with ASRE alone twice: every
+/// member iterated `asre_first_round` times, then only the members still unconverged up to max_iterations
+/// (the others iterate 0 times there). `progress` advances by 2 grid.steps.
+template <class ExecSpace, class Model>
+AsreIterations asre_iterations(const ExecSpace& space, const Model& truth_model, const Model& filter_model,
+                               long members, std::uint32_t seed, const TimeGrid& grid, const FilterConfig& config,
+                               Progress* progress) {
+  constexpr int asre_first_round = 10;  // most members of the seed models converge within it at tolerance 1e-6
+  const int max_iterations = config.asre_max_iterations;
+  std::vector<int> first(members, 0);
+  detail::asre_pass(space, truth_model, filter_model, members, seed, grid, config,
+                    std::vector<int>(members, std::min(asre_first_round, max_iterations)), first, progress, 0);
+  std::vector<int> rest(members, 0);
+  bool any = false;
+  for (long member = 0; member < members; ++member)
+    if (first[member] == 0 && max_iterations > asre_first_round) rest[member] = max_iterations, any = true;
+  if (any) detail::asre_pass(space, truth_model, filter_model, members, seed, grid, config, rest, first, progress, grid.steps);
+  AsreIterations result;
+  result.per_member.resize(members);
+  for (long member = 0; member < members; ++member) {
+    result.per_member[member] = first[member] > 0 ? first[member] : max_iterations;
+    if (first[member] == 0) ++result.not_converged;
   }
   result.min = *std::min_element(result.per_member.begin(), result.per_member.end());
   result.max = *std::max_element(result.per_member.begin(), result.per_member.end());
@@ -76,7 +100,7 @@ AsreIterations asre_iterations(const ExecSpace& space, const Model& truth_model,
 
 /// Runs the filters `filters` (from select_filters<Model>) over `grid`. The truths follow truth_model, the
 /// filters filter_model. With a `reference`, every filter is also scored against its mean (rmse_ref).
-/// `progress` counts steps of both passes when ASRE is selected (2 * grid.steps), else grid.steps.
+/// `progress` counts steps of all passes: 3 grid.steps when ASRE is selected, else grid.steps.
 template <class ExecSpace, class Model>
 FilterReport run_filters(const ExecSpace& space, const Model& truth_model, const Model& filter_model, long members,
                          std::uint32_t seed, const TimeGrid& grid, const std::vector<std::string>& filters,
@@ -98,7 +122,7 @@ FilterReport run_filters(const ExecSpace& space, const Model& truth_model, const
   };
   record(0.0);
   std::size_t next_output = 1;
-  const long progress_base = report.asre.per_member.empty() ? 0 : grid.steps;  // after ASRE's first pass
+  const long progress_base = report.asre.per_member.empty() ? 0 : 2 * grid.steps;  // after ASRE's passes
   for (long k = 0; k < grid.steps; ++k) {
     const bool output = next_output < grid.output_steps.size() && grid.output_steps[next_output] == k + 1;
     bank.step(k, grid.dt, output);

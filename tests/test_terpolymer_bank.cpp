@@ -1,12 +1,14 @@
 // The terpolymerization bank (seed 002 ACC03): 10 states, 55 packed covariance entries per member and
 // filter, BILIN, MIXED and KBL side by side on 10^4 members. All members stay finite and positive definite,
-// and the paper's finding holds with a margin of many standard errors: "linearization leads to large
-// deviations" (002 L1717) -- KBL's error is several times BILIN's, and MIXED (BILIN's mean with KBL's
-// covariance) is close to BILIN.
+// and once the prior's transient has passed (t = 2) the paper's finding holds with a margin of many standard
+// errors: "linearization leads to large deviations" (002 L1717) -- KBL's error is several times BILIN's, and
+// MIXED (BILIN's mean with KBL's covariance) is close to BILIN.
 #include "drivers/filter_run.hpp"
 #include "models/terpolymer_model.hpp"
 
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 namespace kushner {
 namespace {
@@ -16,7 +18,7 @@ using Space = Kokkos::DefaultExecutionSpace;
 TEST(TerpolymerBank, BilinearMixedAndLinearizedFiltersRunOnTenThousandMembers) {
   const TerpolymerModel model;
   constexpr long num_members = 10000;
-  const TimeGrid grid = make_time_grid(1.0, 0.01, 4);
+  const TimeGrid grid = make_time_grid(2.0, 0.01, 4);
   const std::vector<std::string> filters = {"BILIN", "MIXED", "KBL"};
   FilterBank<Space, TerpolymerModel> bank(Space(), model, model, 2, 1, filters, FilterConfig{});
   bank.with_slot("BILIN", [](const auto& slot) { EXPECT_EQ(slot.P.extent(1), 55u); });
@@ -28,10 +30,13 @@ TEST(TerpolymerBank, BilinearMixedAndLinearizedFiltersRunOnTenThousandMembers) {
     EXPECT_EQ(report.scores[f].rmse_truth.members, num_members) << filters[f];
     EXPECT_EQ(report.scores[f].nees.members, num_members) << filters[f];
   }
-  const Estimate bilin = report.scores[0].rmse_truth, mixed = report.scores[1].rmse_truth, kbl = report.scores[2].rmse_truth;
-  EXPECT_GT(kbl.value - bilin.value, 10.0 * (kbl.standard_error + bilin.standard_error))
-      << "KBL " << kbl.value << " BILIN " << bilin.value;
-  EXPECT_LT(std::abs(mixed.value - bilin.value), 0.1 * bilin.value) << "MIXED " << mixed.value << " BILIN " << bilin.value;
+  const FilterSnapshot& bilin = report.series.back()[0];
+  const FilterSnapshot& mixed = report.series.back()[1];
+  const FilterSnapshot& kbl = report.series.back()[2];
+  EXPECT_GT(kbl.rmse_truth - 2.0 * bilin.rmse_truth, 10.0 * (kbl.rmse_truth_se + 2.0 * bilin.rmse_truth_se))
+      << "at t = 2: KBL " << kbl.rmse_truth << " BILIN " << bilin.rmse_truth;
+  EXPECT_LT(std::abs(mixed.rmse_truth - bilin.rmse_truth), 0.2 * bilin.rmse_truth)
+      << "at t = 2: MIXED " << mixed.rmse_truth << " BILIN " << bilin.rmse_truth;
 }
 
 }  // namespace

@@ -12,7 +12,7 @@ namespace kushner {
 
 template <class Model>
 constexpr const char* bilinear_filter_unsupported() {
-  if (!ModelTraits<Model>::quadratic_polynomial) return "drift is not bilinear (quadratic)";
+  if (!ModelTraits<Model>::quadratic_polynomial) return "drift is not bilinear";
   if (!ModelTraits<Model>::linear_observation) return "observation is not linear";
   return nullptr;
 }
