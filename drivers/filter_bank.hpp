@@ -33,7 +33,7 @@ struct FilterSnapshot {
   double nees = 0.0;        // mean over members with positive definite P
   double nees_se = 0.0;
   double rmse_ref = 0.0;    // against the reference mean, when there is one
-  long diverged = 0;        // members whose filter has diverged by now
+  long diverged = 0;        // members whose filter has diverged by now (their truth not escaped)
 };
 
 /// One filter over the whole run: time-and-ensemble means over the members scored at the end.
@@ -41,7 +41,7 @@ struct FilterScores {
   Estimate rmse_truth;  // root of the time-and-ensemble mean squared error; SE by the delta method
   Estimate nees;        // mean NEES (per member, the time average over points where P is positive definite)
   Estimate rmse_ref;
-  long diverged = 0, not_positive_definite = 0, non_finite = 0;
+  long diverged = 0, not_positive_definite = 0, non_finite = 0;  // among members whose truth did not escape
 };
 
 template <class ExecSpace, class Model>
@@ -117,6 +117,8 @@ class FilterBank {
 
   const std::vector<std::string>& filter_names() const { return names_; }
   const TruthBank<ExecSpace, Model>& truths() const { return truths_; }
+  /// (member): non_finite once the member's truth escaped to infinity.
+  const BankScalar<Status, MemSpace>& truth_status() const { return truth_status_; }
   long members() const { return members_; }
 
   /// Calls f(slot) with the slot of filter `name` (a selected one).
@@ -149,8 +151,8 @@ class FilterBank {
       s.nees = nees.value;
       s.nees_se = nees.standard_error;
       s.rmse_ref = reference_ ? root_mean(slot.snapshot, snapshot_reference_squared_error).value : std::nan("");
-      s.diverged = count_status(space_, slot.status, Status::not_positive_definite) +
-                   count_status(space_, slot.status, Status::non_finite);
+      s.diverged = count_status(space_, slot.status, Status::not_positive_definite, truth_status_) +
+                   count_status(space_, slot.status, Status::non_finite, truth_status_);
     });
     return s;
   }
@@ -166,8 +168,8 @@ class FilterBank {
       s.rmse_truth = root_mean(per_member, member_mean_squared_error);
       s.nees = mean(per_member, member_mean_nees);
       s.rmse_ref = root_mean(per_member, member_mean_squared_reference_error);
-      s.not_positive_definite = count_status(space_, slot.status, Status::not_positive_definite);
-      s.non_finite = count_status(space_, slot.status, Status::non_finite);
+      s.not_positive_definite = count_status(space_, slot.status, Status::not_positive_definite, truth_status_);
+      s.non_finite = count_status(space_, slot.status, Status::non_finite, truth_status_);
       s.diverged = s.not_positive_definite + s.non_finite;
     });
     return s;

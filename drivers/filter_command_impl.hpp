@@ -56,6 +56,7 @@ nlohmann::json filter_summary(const FilterReport& report, const FilterConfig& co
                          {"min", report.asre.min},
                          {"max", report.asre.max},
                          {"not_converged", report.asre.not_converged},
+                         {"diverged", report.asre.diverged},
                          {"tolerance", config.asre_tolerance},
                          {"max_iterations", config.asre_max_iterations}};
     filters[report.filters[f]] = j;

@@ -12,6 +12,7 @@
 #include <Kokkos_Core.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -23,7 +24,8 @@ struct AsreIterations {
   std::vector<int> per_member;  // the iterate reported (0 = the frozen-coefficient Kalman-Bucy run)
   double mean = 0.0;
   int min = 0, max = 0;
-  long not_converged = 0;  // members that reached max_iterations (or diverged) without meeting the tolerance
+  long not_converged = 0;  // members that reached max_iterations without meeting the tolerance
+  long diverged = 0;       // members whose ASRE iterates diverged (or whose truth escaped): left out above
 };
 
 struct FilterReport {
@@ -39,11 +41,12 @@ struct FilterReport {
 namespace detail {
 
 /// One pass of the truths with ASRE alone, member `i` iterated iterations[i] times; marks in `first` each
-/// member's first iterate j >= 1 (among those run) with max_t |m^[j] - m^[j-1]| < tolerance.
+/// member's first iterate j >= 1 (among those run) with max_t |m^[j] - m^[j-1]| < tolerance, and in
+/// `diverged` the members whose iterates (or truth) did not stay finite.
 template <class ExecSpace, class Model>
 void asre_pass(const ExecSpace& space, const Model& truth_model, const Model& filter_model, long members,
                std::uint32_t seed, const TimeGrid& grid, FilterConfig config, const std::vector<int>& iterations,
-               std::vector<int>& first, Progress* progress, long progress_base) {
+               std::vector<int>& first, std::vector<char>& diverged, Progress* progress, long progress_base) {
   config.asre_iterations = iterations;
   FilterBank<ExecSpace, Model> bank(space, truth_model, filter_model, members, seed, {"ASRE"}, config);
   for (long k = 0; k < grid.steps; ++k) {
@@ -55,12 +58,15 @@ void asre_pass(const ExecSpace& space, const Model& truth_model, const Model& fi
     const auto& slot = bank.template slot<AsreFilter>();
     const auto change = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), slot.filter.change);
     const auto status = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), slot.status);
-    for (long member = 0; member < members; ++member)
-      for (int i = 1; i <= iterations[member] && status(member) == Status::ok; ++i)
+    const auto truth_status = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bank.truth_status());
+    for (long member = 0; member < members; ++member) {
+      if (status(member) != Status::ok || truth_status(member) != Status::ok) diverged[member] = 1;
+      for (int i = 1; i <= iterations[member] && !diverged[member]; ++i)
         if (change(member, i) < config.asre_tolerance) {
           first[member] = i;
           break;
         }
+    }
   }
 }
 
@@ -77,24 +83,32 @@ AsreIterations asre_iterations(const ExecSpace& space, const Model& truth_model,
   constexpr int asre_first_round = 10;  // most members of the seed models converge within it at tolerance 1e-6
   const int max_iterations = config.asre_max_iterations;
   std::vector<int> first(members, 0);
+  std::vector<char> diverged(members, 0);
   detail::asre_pass(space, truth_model, filter_model, members, seed, grid, config,
-                    std::vector<int>(members, std::min(asre_first_round, max_iterations)), first, progress, 0);
+                    std::vector<int>(members, std::min(asre_first_round, max_iterations)), first, diverged, progress, 0);
   std::vector<int> rest(members, 0);
   bool any = false;
   for (long member = 0; member < members; ++member)
-    if (first[member] == 0 && max_iterations > asre_first_round) rest[member] = max_iterations, any = true;
-  if (any) detail::asre_pass(space, truth_model, filter_model, members, seed, grid, config, rest, first, progress, grid.steps);
+    if (first[member] == 0 && !diverged[member] && max_iterations > asre_first_round) rest[member] = max_iterations, any = true;
+  if (any)
+    detail::asre_pass(space, truth_model, filter_model, members, seed, grid, config, rest, first, diverged, progress,
+                      grid.steps);
   AsreIterations result;
   result.per_member.resize(members);
+  result.min = max_iterations;
+  double sum = 0.0;
   for (long member = 0; member < members; ++member) {
     result.per_member[member] = first[member] > 0 ? first[member] : max_iterations;
+    if (diverged[member]) {
+      ++result.diverged;
+      continue;
+    }
     if (first[member] == 0) ++result.not_converged;
+    result.min = std::min(result.min, result.per_member[member]);
+    result.max = std::max(result.max, result.per_member[member]);
+    sum += result.per_member[member];
   }
-  result.min = *std::min_element(result.per_member.begin(), result.per_member.end());
-  result.max = *std::max_element(result.per_member.begin(), result.per_member.end());
-  double sum = 0.0;
-  for (int i : result.per_member) sum += i;
-  result.mean = sum / members;
+  result.mean = members > result.diverged ? sum / (members - result.diverged) : std::nan("");
   return result;
 }
 

@@ -33,18 +33,24 @@ struct MemberScores {
   }
 };
 
+/// Members with status `which` among those whose truth is ok (all members when truth_status is empty): a
+/// filter that fails because its truth escaped to infinity has not diverged, its member just left the run.
 template <class MemSpace>
 struct CountStatus {
-  BankScalar<Status, MemSpace> status;
+  BankScalar<Status, MemSpace> status, truth_status;
   Status which;
-  KOKKOS_INLINE_FUNCTION void operator()(const int member, long& count) const { count += status(member) == which ? 1 : 0; }
+  KOKKOS_INLINE_FUNCTION void operator()(const int member, long& count) const {
+    const bool counted = truth_status.extent(0) == 0 || truth_status(member) == Status::ok;
+    count += counted && status(member) == which ? 1 : 0;
+  }
 };
 
 template <class ExecSpace, class MemSpace>
-long count_status(const ExecSpace& space, const BankScalar<Status, MemSpace>& status, Status which) {
+long count_status(const ExecSpace& space, const BankScalar<Status, MemSpace>& status, Status which,
+                  const BankScalar<Status, MemSpace>& truth_status = {}) {
   long count = 0;
   Kokkos::parallel_reduce("kushner::count_status", Kokkos::RangePolicy<ExecSpace>(space, 0, status.extent(0)),
-                          CountStatus<MemSpace>{status, which}, count);
+                          CountStatus<MemSpace>{status, truth_status, which}, count);
   return count;
 }
 

@@ -56,7 +56,6 @@ struct declares_non_integrable_drift<Model, std::enable_if_t<!Model::drift_gauss
 /// Capabilities of a continuous-time model, as the filters see them.
 template <class Model>
 struct ModelTraits {
-  static constexpr int n = Model::state_dim, p = Model::obs_dim;
   static constexpr bool linear = detail::has_linear_form<Model>::value;
   /// h(t, x) = h(t, 0) + H x, H = observation_jacobian(t, .) constant in x.
   static constexpr bool linear_observation = linear || detail::declares_linear_observation<Model>::value;
