@@ -30,10 +30,10 @@ struct Estimate {
 struct FilterSnapshot {
   double rmse_truth = 0.0;  // sqrt of the mean over scored members of |m - x|^2
   double rmse_truth_se = 0.0;
-  double nees = 0.0;        // mean over members with positive definite P
+  double nees = 0.0;  // mean over members with positive definite P
   double nees_se = 0.0;
-  double rmse_ref = 0.0;    // against the reference mean, when there is one
-  long diverged = 0;        // members whose filter has diverged by now (their truth not escaped)
+  double rmse_ref = 0.0;  // against the reference mean, when there is one
+  long diverged = 0;      // members whose filter has diverged by now (their truth not escaped)
 };
 
 /// One filter over the whole run: time-and-ensemble means over the members scored at the end.
@@ -86,11 +86,11 @@ class FilterBank {
         slot.P = BankSymmetric<MemSpace>(std::string("kushner::P_") + Filter::name, members, packed_size(n));
         slot.status = BankScalar<Status, MemSpace>(std::string("kushner::status_") + Filter::name, members);
         slot.score = BankVector<MemSpace>(std::string("kushner::score_") + Filter::name, members, num_score_columns);
-        slot.snapshot = BankVector<MemSpace>(std::string("kushner::snapshot_") + Filter::name, members, num_snapshot_columns);
+        slot.snapshot =
+            BankVector<MemSpace>(std::string("kushner::snapshot_") + Filter::name, members, num_snapshot_columns);
         fill_prior(slot.m, slot.P);
       });
       KUSHNER_REQUIRE(found, "filter '" << name << "' is not supported by model " << Model::name);
-      names_.push_back(name);
     }
     Kokkos::parallel_for("kushner::filter_bank_initial_score", Kokkos::RangePolicy<ExecSpace>(space_, 0, members_),
                          typename K::Initial{truths_.state(), slots_});
@@ -105,8 +105,8 @@ class FilterBank {
   /// Step k, over [k dt, (k + 1) dt]; `record`: (k + 1) dt is an output time.
   void step(long k, double dt, bool record) {
     const auto step = static_cast<std::uint32_t>(k);
-    typename K::Step kernel{EulerMaruyamaTruthStep<Model, MemSpace>{truth_model_, truths_.state(), truths_.observations(),
-                                                                     k * dt, dt, seed_, step},
+    typename K::Step kernel{EulerMaruyamaTruthStep<Model, MemSpace>{truth_model_, truths_.state(),
+                                                                    truths_.observations(), k * dt, dt, seed_, step},
                             filter_model_, truth_status_, slots_, record};
     Kokkos::parallel_for("kushner::filter_bank_step", Kokkos::RangePolicy<ExecSpace>(space_, 0, members_), kernel);
     if (reference_) {
@@ -115,11 +115,9 @@ class FilterBank {
     }
   }
 
-  const std::vector<std::string>& filter_names() const { return names_; }
   const TruthBank<ExecSpace, Model>& truths() const { return truths_; }
   /// (member): non_finite once the member's truth escaped to infinity.
   const BankScalar<Status, MemSpace>& truth_status() const { return truth_status_; }
-  long members() const { return members_; }
 
   /// Calls f(slot) with the slot of filter `name` (a selected one).
   template <class F>
@@ -238,7 +236,6 @@ class FilterBank {
   TruthBank<ExecSpace, Model> truths_;
   BankScalar<Status, MemSpace> truth_status_;
   typename K::Slots slots_;
-  std::vector<std::string> names_;
   ReferenceMean<MemSpace>* reference_ = nullptr;
 };
 

@@ -1,5 +1,5 @@
-#include "drivers/commands.hpp"
 #include "drivers/filter_command.hpp"
+#include "drivers/commands.hpp"
 #include "models/registry.hpp"
 
 namespace kushner {

@@ -77,11 +77,12 @@ void run_filter_command(const Model& model, const FilterOptions& options, const 
   with_backend(context.backend, [&](const auto& space) {
     const bool asre = std::find(filters.begin(), filters.end(), "ASRE") != filters.end();
     Progress progress("filter", grid.steps * (asre ? 3 : 1), !options.run.quiet);
-    const FilterReport report = run_filters(space, model, model, options.run.members,
-                                            static_cast<std::uint32_t>(options.run.seed), grid, filters, config,
-                                            nullptr, &progress);
+    const FilterReport report =
+        run_filters(space, model, model, options.run.members, static_cast<std::uint32_t>(options.run.seed), grid,
+                    filters, config, nullptr, &progress);
     nlohmann::json summary = run_metadata(context);
-    summary["model"] = {{"name", Model::name}, {"state_dim", Model::state_dim}, {"parameters", parameter_values(model)}};
+    summary["model"] = {
+        {"name", Model::name}, {"state_dim", Model::state_dim}, {"parameters", parameter_values(model)}};
     summary["members"] = options.run.members;
     summary["T"] = options.run.T;
     summary["dt"] = options.run.dt;

@@ -4,7 +4,7 @@
 
 namespace kushner {
 
-template void run_filter_command<TerpolymerModel>(const TerpolymerModel&, const FilterOptions&, const FilterConfig&, const TimeGrid&,
-                                        const RunContext&);
+template void run_filter_command<TerpolymerModel>(const TerpolymerModel&, const FilterOptions&, const FilterConfig&,
+                                                  const TimeGrid&, const RunContext&);
 
 }  // namespace kushner

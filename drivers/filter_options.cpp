@@ -1,5 +1,4 @@
 #include "drivers/filter_options.hpp"
-
 #include "kernels/errors.hpp"
 
 #include <cmath>
@@ -8,7 +7,8 @@ namespace kushner {
 
 void add_filter_options(CLI::App& app, FilterOptions& o) {
   add_run_options(app, o.run);
-  app.add_option("--filters", o.filters, "comma-separated filters, or all (see `kushner filters`)")->capture_default_str();
+  app.add_option("--filters", o.filters, "comma-separated filters, or all (see `kushner filters`)")
+      ->capture_default_str();
   app.add_option("--qlf-expectations", o.qlf_expectations,
                  "QLF's Gaussian expectations: closed (the model's formulas), cubature (Gauss-Hermite), or auto "
                  "(closed where the model has them)")

@@ -29,13 +29,13 @@ struct AsreIterations {
 };
 
 struct FilterReport {
-  std::vector<std::string> filters;                   // report order
-  std::vector<double> times;                          // output times
-  std::vector<std::vector<FilterSnapshot>> series;    // [time][filter]
-  std::vector<FilterScores> scores;                   // [filter], over the whole run
-  long truths_escaped = 0;                            // members left out of every metric
+  std::vector<std::string> filters;                 // report order
+  std::vector<double> times;                        // output times
+  std::vector<std::vector<FilterSnapshot>> series;  // [time][filter]
+  std::vector<FilterScores> scores;                 // [filter], over the whole run
+  long truths_escaped = 0;                          // members left out of every metric
   bool has_reference = false;
-  AsreIterations asre;                                // when ASRE is among the filters
+  AsreIterations asre;  // when ASRE is among the filters
 };
 
 namespace detail {
@@ -85,11 +85,13 @@ AsreIterations asre_iterations(const ExecSpace& space, const Model& truth_model,
   std::vector<int> first(members, 0);
   std::vector<char> diverged(members, 0);
   detail::asre_pass(space, truth_model, filter_model, members, seed, grid, config,
-                    std::vector<int>(members, std::min(asre_first_round, max_iterations)), first, diverged, progress, 0);
+                    std::vector<int>(members, std::min(asre_first_round, max_iterations)), first, diverged, progress,
+                    0);
   std::vector<int> rest(members, 0);
   bool any = false;
   for (long member = 0; member < members; ++member)
-    if (first[member] == 0 && !diverged[member] && max_iterations > asre_first_round) rest[member] = max_iterations, any = true;
+    if (first[member] == 0 && !diverged[member] && max_iterations > asre_first_round)
+      rest[member] = max_iterations, any = true;
   if (any)
     detail::asre_pass(space, truth_model, filter_model, members, seed, grid, config, rest, first, diverged, progress,
                       grid.steps);

@@ -39,14 +39,15 @@ std::vector<std::string> select_filters(const std::string& list) {
     }
   }
   for (const auto& name : requested) {
-    const auto it = std::find_if(support.begin(), support.end(), [&](const FilterSupport& f) { return f.name == name; });
+    const auto it =
+        std::find_if(support.begin(), support.end(), [&](const FilterSupport& f) { return f.name == name; });
     if (it == support.end()) {
       std::string known;
       for (const auto& f : support) known += (known.empty() ? "" : ", ") + f.name;
       throw InputError("--filters: unknown filter '" + name + "' (known: " + known + ", or all)");
     }
     KUSHNER_INPUT_REQUIRE(it->unsupported == nullptr, "filter " << name << " does not support model '" << Model::name
-                                                                 << "' (" << it->unsupported << ")");
+                                                                << "' (" << it->unsupported << ")");
   }
   std::vector<std::string> ordered;  // report order, each once
   for (const auto& f : support)

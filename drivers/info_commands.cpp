@@ -3,9 +3,8 @@
 #include "drivers/filter_selection.hpp"
 #include "models/registry.hpp"
 
-#include <map>
-
 #include <iostream>
+#include <map>
 
 namespace kushner {
 
@@ -26,6 +25,15 @@ int run_models(bool json) {
   return 0;
 }
 
+/// Whether `kushner filters` lists this type: a name with several dimensions is listed at its default.
+template <class Model>
+constexpr bool listed_once() {
+  if constexpr (dimension_choice<Model>::selectable)
+    return Model::state_dim == dimension_choice<Model>::default_dim;
+  else
+    return true;
+}
+
 int run_filters_list(bool json) {
   // filter name -> (supported models, refused models with the reason), in report order
   const std::vector<std::string> names = all_filter_names();
@@ -33,10 +41,7 @@ int run_filters_list(bool json) {
   std::map<std::string, std::string> descriptions;
   detail::for_each_model_type([&](auto* tag) {
     using Model = std::remove_pointer_t<decltype(tag)>;
-    if constexpr (!Model::discrete_time) {
-      if constexpr (dimension_choice<Model>::selectable) {
-        if (Model::state_dim != dimension_choice<Model>::default_dim) return;  // one entry per name
-      }
+    if constexpr (!Model::discrete_time && listed_once<Model>()) {
       for (const auto& f : filter_support<Model>()) {
         descriptions[f.name] = f.description;
         if (f.unsupported == nullptr) supported[f.name].push_back(Model::name);

@@ -54,7 +54,8 @@ struct CarBase : InitialLaw<2> {
 struct CarModel : CarBase {
   static constexpr const char* name = "car";
   static constexpr const char* description =
-      "Basin's kinematic car (orientation, steering angle): dphi = (v/l) tan(delta) dt, ddelta = u dt, dz = x dt + r dv";
+      "Basin's kinematic car (orientation, steering angle): dphi = (v/l) tan(delta) dt, ddelta = u dt, dz = x dt + r "
+      "dv";
   /// E|tan(delta)| is infinite for Gaussian delta (poles at +-pi/2): no quasi-linear filter exists.
   static constexpr bool drift_gaussian_integrable = false;
 

@@ -23,8 +23,8 @@ struct TerpolymerModel : InitialLaw<10> {
   static constexpr int num_bilinear_terms = 32;
   using Control = Vec<control_dim>;
 
-  double V = 1.0, theta = 1.0;                              // reactor volume, residence time
-  double F_m1 = 1.0, F_m2 = 1.0, F_m3 = 1.0, F_cat = 1.0;   // net molar inflows dDelta/dt of monomers and catalyst
+  double V = 1.0, theta = 1.0;                             // reactor volume, residence time
+  double F_m1 = 1.0, F_m2 = 1.0, F_m3 = 1.0, F_cat = 1.0;  // net molar inflows dDelta/dt of monomers and catalyst
   double K_L1 = 1.0, K_L2 = 1.0, K_11 = 1.0, K_21 = 1.0, K_31 = 1.0, K_12 = 1.0, K_22 = 1.0, K_13 = 1.0;
   double K_d = 1.0, K_t1 = 1.0, K_t2 = 1.0, K_t3 = 1.0;
   double q = 0.0, r = 1.0;
@@ -70,8 +70,7 @@ struct TerpolymerModel : InitialLaw<10> {
     const double c1 = x[0], c2 = x[1], c3 = x[2], cs = x[3], mp = x[4], mq = x[5], mr = x[6];
     const double out = 1.0 / theta;
     return {{F_m1 / V - (out + K_L1 * cs + K_11 * mp + K_21 * mq + K_31 * mr) * c1,
-             F_m2 / V - (out + K_L2 * cs + K_12 * mp + K_22 * mq) * c2,
-             F_m3 / V - (out + K_13 * mp) * c3,
+             F_m2 / V - (out + K_L2 * cs + K_12 * mp + K_22 * mq) * c2, F_m3 / V - (out + K_13 * mp) * c3,
              F_cat / V - (out + K_d + K_L1 * c1 + K_L2 * c2) * cs,
              (-out - K_t1) * mp + K_L1 * c1 * cs - (K_12 * c2 + K_13 * c3) * mp + K_21 * c1 * mq + K_31 * c1 * mr,
              -out * mq + K_L2 * c2 * cs - (K_21 * c1 + K_t2) * mq + K_12 * c2 * mp,
@@ -92,18 +91,38 @@ struct TerpolymerModel : InitialLaw<10> {
     f.a1(5, 5) -= K_t2;
     f.a1(6, 6) -= K_t3;
     enum : int { c1 = 0, c2, c3, cs, mp, mq, mr, l100, l010, l001 };
-    f.add(c1, c1, cs, -K_L1); f.add(c1, c1, mp, -K_11); f.add(c1, c1, mq, -K_21); f.add(c1, c1, mr, -K_31);
-    f.add(c2, c2, cs, -K_L2); f.add(c2, c2, mp, -K_12); f.add(c2, c2, mq, -K_22);
+    f.add(c1, c1, cs, -K_L1);
+    f.add(c1, c1, mp, -K_11);
+    f.add(c1, c1, mq, -K_21);
+    f.add(c1, c1, mr, -K_31);
+    f.add(c2, c2, cs, -K_L2);
+    f.add(c2, c2, mp, -K_12);
+    f.add(c2, c2, mq, -K_22);
     f.add(c3, c3, mp, -K_13);
-    f.add(cs, c1, cs, -K_L1); f.add(cs, c2, cs, -K_L2);
-    f.add(mp, c1, cs, K_L1); f.add(mp, c2, mp, -K_12); f.add(mp, c3, mp, -K_13); f.add(mp, c1, mq, K_21);
+    f.add(cs, c1, cs, -K_L1);
+    f.add(cs, c2, cs, -K_L2);
+    f.add(mp, c1, cs, K_L1);
+    f.add(mp, c2, mp, -K_12);
+    f.add(mp, c3, mp, -K_13);
+    f.add(mp, c1, mq, K_21);
     f.add(mp, c1, mr, K_31);
-    f.add(mq, c2, cs, K_L2); f.add(mq, c1, mq, -K_21); f.add(mq, c2, mp, K_12);
-    f.add(mr, c1, mr, -K_31); f.add(mr, c3, mp, K_13);
-    f.add(l100, c1, cs, K_L1); f.add(l100, c2, cs, K_L2); f.add(l100, c1, mp, K_11); f.add(l100, c1, mq, K_21);
+    f.add(mq, c2, cs, K_L2);
+    f.add(mq, c1, mq, -K_21);
+    f.add(mq, c2, mp, K_12);
+    f.add(mr, c1, mr, -K_31);
+    f.add(mr, c3, mp, K_13);
+    f.add(l100, c1, cs, K_L1);
+    f.add(l100, c2, cs, K_L2);
+    f.add(l100, c1, mp, K_11);
+    f.add(l100, c1, mq, K_21);
     f.add(l100, c1, mr, K_31);
-    f.add(l010, c1, cs, K_L1); f.add(l010, c2, cs, K_L2); f.add(l010, c2, mp, K_12); f.add(l010, c2, mq, K_22);
-    f.add(l001, c1, cs, K_L1); f.add(l001, c2, cs, K_L2); f.add(l001, c3, mp, K_13);
+    f.add(l010, c1, cs, K_L1);
+    f.add(l010, c2, cs, K_L2);
+    f.add(l010, c2, mp, K_12);
+    f.add(l010, c2, mq, K_22);
+    f.add(l001, c1, cs, K_L1);
+    f.add(l001, c2, cs, K_L2);
+    f.add(l001, c3, mp, K_13);
     return f;
   }
 
@@ -128,8 +147,12 @@ struct TerpolymerModel : InitialLaw<10> {
   }
   KOKKOS_INLINE_FUNCTION Mat<10, 10> diffusion(double, const Vec<10>&) const { return Mat<10, 10>::diagonal(q); }
   KOKKOS_INLINE_FUNCTION Vec<10> observation(double, const Vec<10>& x) const { return x; }
-  KOKKOS_INLINE_FUNCTION Mat<10, 10> observation_jacobian(double, const Vec<10>&) const { return Mat<10, 10>::identity(); }
-  KOKKOS_INLINE_FUNCTION Mat<10, 10> observation_hessian(double, const Vec<10>&, int) const { return Mat<10, 10>::zero(); }
+  KOKKOS_INLINE_FUNCTION Mat<10, 10> observation_jacobian(double, const Vec<10>&) const {
+    return Mat<10, 10>::identity();
+  }
+  KOKKOS_INLINE_FUNCTION Mat<10, 10> observation_hessian(double, const Vec<10>&, int) const {
+    return Mat<10, 10>::zero();
+  }
   KOKKOS_INLINE_FUNCTION Mat<10, 10> observation_noise(double) const { return Mat<10, 10>::diagonal(r); }
 
   /// A(x) x + b with A_ki = a1_ki + sum_j a2_kij x_j (a2 symmetric; /work/notes/filters.md 2.5), b = a0.

@@ -61,10 +61,30 @@ void BM_TruthStepAlone(benchmark::State& state) {
   state.counters["member_steps_per_s"] = C(static_cast<double>(members), C::kIsIterationInvariantRate);
 }
 
-BENCHMARK_TEMPLATE(BM_FilterBankStep, SineModel)->ArgName("members")->Arg(10000)->Arg(100000)->Arg(1000000)->UseManualTime();
-BENCHMARK_TEMPLATE(BM_TruthStepAlone, SineModel)->ArgName("members")->Arg(10000)->Arg(100000)->Arg(1000000)->UseManualTime();
-BENCHMARK_TEMPLATE(BM_FilterBankStep, CubicOscillatorModel)->ArgName("members")->Arg(10000)->Arg(100000)->Arg(1000000)->UseManualTime();
-BENCHMARK_TEMPLATE(BM_TruthStepAlone, CubicOscillatorModel)->ArgName("members")->Arg(10000)->Arg(100000)->Arg(1000000)->UseManualTime();
+BENCHMARK_TEMPLATE(BM_FilterBankStep, SineModel)
+    ->ArgName("members")
+    ->Arg(10000)
+    ->Arg(100000)
+    ->Arg(1000000)
+    ->UseManualTime();
+BENCHMARK_TEMPLATE(BM_TruthStepAlone, SineModel)
+    ->ArgName("members")
+    ->Arg(10000)
+    ->Arg(100000)
+    ->Arg(1000000)
+    ->UseManualTime();
+BENCHMARK_TEMPLATE(BM_FilterBankStep, CubicOscillatorModel)
+    ->ArgName("members")
+    ->Arg(10000)
+    ->Arg(100000)
+    ->Arg(1000000)
+    ->UseManualTime();
+BENCHMARK_TEMPLATE(BM_TruthStepAlone, CubicOscillatorModel)
+    ->ArgName("members")
+    ->Arg(10000)
+    ->Arg(100000)
+    ->Arg(1000000)
+    ->UseManualTime();
 
 }  // namespace
 }  // namespace kushner

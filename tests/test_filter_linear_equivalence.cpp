@@ -10,7 +10,6 @@
 
 #include <gtest/gtest.h>
 
-
 namespace kushner {
 namespace {
 
@@ -85,7 +84,8 @@ TEST(FilterBankOnLinearModel, DifferentModelIsDetected) {
     b.step(k, dt, false);
   }
   a.with_slot("KB", [&](const auto& sa) {
-    b.with_slot("KB", [&](const auto& sb) { EXPECT_GT(test::largest_relative_difference(sb.m, sa.m), 100 * tolerance); });
+    b.with_slot("KB",
+                [&](const auto& sb) { EXPECT_GT(test::largest_relative_difference(sb.m, sa.m), 100 * tolerance); });
   });
 }
 

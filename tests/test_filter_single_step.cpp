@@ -32,7 +32,9 @@ struct QuadraticObservationModel : InitialLaw<1> {
   KOKKOS_INLINE_FUNCTION Mat<1, 1> drift_hessian(double, const Vec<1>&, const Control&, int) const { return {{{0.0}}}; }
   KOKKOS_INLINE_FUNCTION Mat<1, 1> diffusion(double, const Vec<1>&) const { return {{{q}}}; }
   KOKKOS_INLINE_FUNCTION Vec<1> observation(double, const Vec<1>& x) const { return {{x[0] + c * x[0] * x[0]}}; }
-  KOKKOS_INLINE_FUNCTION Mat<1, 1> observation_jacobian(double, const Vec<1>& x) const { return {{{1.0 + 2.0 * c * x[0]}}}; }
+  KOKKOS_INLINE_FUNCTION Mat<1, 1> observation_jacobian(double, const Vec<1>& x) const {
+    return {{{1.0 + 2.0 * c * x[0]}}};
+  }
   KOKKOS_INLINE_FUNCTION Mat<1, 1> observation_hessian(double, const Vec<1>&, int) const { return {{{2.0 * c}}}; }
   KOKKOS_INLINE_FUNCTION Mat<1, 1> observation_noise(double) const { return {{{r}}}; }
 };
@@ -125,8 +127,8 @@ TEST(FilterSingleStep, SineEkfSofQlfAsreKbl) {
     double a = 0.0, J = 0.0;
     const std::string n = name;
     if (n == "EKF" || n == "EKF-DS") a = -std::sin(m), J = -std::cos(m);
-    if (n == "SOF" || n == "SOF-B") a = -std::sin(m) + 0.5 * std::sin(m) * P, J = -std::cos(m);       // (6.10)-(6.11)
-    if (n == "QLF") a = -std::sin(m) * std::exp(-0.5 * P), J = -std::cos(m) * std::exp(-0.5 * P);      // (6.4)-(6.5)
+    if (n == "SOF" || n == "SOF-B") a = -std::sin(m) + 0.5 * std::sin(m) * P, J = -std::cos(m);    // (6.10)-(6.11)
+    if (n == "QLF") a = -std::sin(m) * std::exp(-0.5 * P), J = -std::cos(m) * std::exp(-0.5 * P);  // (6.4)-(6.5)
     if (n == "ASRE") J = -std::sin(s.m0) / s.m0, a = J * m;  // every iterate linearizes at m(0) on the first step
     if (n == "KBL") a = -m, J = -1.0;
     expect_step(s, m + a * dt, (1 + J * dt) * (1 + J * dt) * P + q * q * dt, name);

@@ -43,7 +43,8 @@ void expect_forms_match_drift(const Model& model) {
   for (int k = 0; k < 5; ++k) {
     const Vec<n> x = test_point<Model>(k);
     const Vec<n> f = model.drift(t, x, u);
-    if constexpr (T::power_polynomial) expect_vectors_near(drift_power_polynomial(model, t)(x), f, 1e-13, name + " power polynomial");
+    if constexpr (T::power_polynomial)
+      expect_vectors_near(drift_power_polynomial(model, t)(x), f, 1e-13, name + " power polynomial");
     if constexpr (T::quadratic_polynomial)
       expect_vectors_near(drift_quadratic_polynomial(model, t)(x), f, 1e-13, name + " quadratic polynomial");
     if constexpr (T::sdc) {

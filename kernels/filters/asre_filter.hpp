@@ -35,33 +35,36 @@ template <class Model, class MemSpace>
 struct AsreFilter {
   static constexpr int n = Model::state_dim, p = Model::obs_dim;
   static constexpr const char* name = "ASRE";
-  static constexpr const char* description = "approximating sequence of Riccati equations, Cimen-Banks (iterated over the horizon)";
+  static constexpr const char* description =
+      "approximating sequence of Riccati equations, Cimen-Banks (iterated over the horizon)";
   static constexpr const char* unsupported = asre_unsupported<Model>();
 
   Vec<n> prior_mean;
-  Kokkos::View<int*, MemSpace> iterations;                    // (member): the iterate reported
-  Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace> m;    // (member, i, iterate)
-  Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace> P;    // (member, packed k, iterate)
+  Kokkos::View<int*, MemSpace> iterations;                      // (member): the iterate reported
+  Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace> m;      // (member, i, iterate)
+  Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace> P;      // (member, packed k, iterate)
   Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> change;  // (member, iterate): max_t |m^[i] - m^[i-1]|_inf
 
   static AsreFilter create(const FilterConfig& config, const Model& model, long members) {
     KUSHNER_INPUT_REQUIRE(config.asre_max_iterations >= 1 && config.asre_max_iterations <= 1000,
                           "--asre-max-iterations: must be in 1 .. 1000 (got " << config.asre_max_iterations << ")");
-    KUSHNER_REQUIRE(config.asre_iterations.empty() || static_cast<long>(config.asre_iterations.size()) == members,
-                    "asre_iterations has " << config.asre_iterations.size() << " entries for " << members << " members");
+    KUSHNER_REQUIRE(
+        config.asre_iterations.empty() || static_cast<long>(config.asre_iterations.size()) == members,
+        "asre_iterations has " << config.asre_iterations.size() << " entries for " << members << " members");
     AsreFilter f;
     f.prior_mean = model.prior_mean;
     f.iterations = Kokkos::View<int*, MemSpace>("kushner::asre_iterations", members);
     auto iterations_host = Kokkos::create_mirror_view(f.iterations);
     for (long member = 0; member < members; ++member)
-      iterations_host(member) = config.asre_iterations.empty() ? config.asre_max_iterations : config.asre_iterations[member];
+      iterations_host(member) =
+          config.asre_iterations.empty() ? config.asre_max_iterations : config.asre_iterations[member];
     Kokkos::deep_copy(f.iterations, iterations_host);
-    const int iterates =
-        1 + (config.asre_iterations.empty()
-                 ? config.asre_max_iterations
-                 : *std::max_element(config.asre_iterations.begin(), config.asre_iterations.end()));
+    const int iterates = 1 + (config.asre_iterations.empty()
+                                  ? config.asre_max_iterations
+                                  : *std::max_element(config.asre_iterations.begin(), config.asre_iterations.end()));
     f.m = decltype(f.m)(Kokkos::view_alloc(Kokkos::WithoutInitializing, "kushner::asre_m"), members, n, iterates);
-    f.P = decltype(f.P)(Kokkos::view_alloc(Kokkos::WithoutInitializing, "kushner::asre_P"), members, packed_size(n), iterates);
+    f.P = decltype(f.P)(Kokkos::view_alloc(Kokkos::WithoutInitializing, "kushner::asre_P"), members, packed_size(n),
+                        iterates);
     f.change = decltype(f.change)("kushner::asre_change", members, iterates);
     auto m_host = Kokkos::create_mirror_view(f.m);
     auto P_host = Kokkos::create_mirror_view(f.P);
@@ -78,7 +81,8 @@ struct AsreFilter {
 
   KOKKOS_INLINE_FUNCTION Status step(const Model& model, int member, const StepInput<p>& in, Vec<n>& m_out,
                                      Mat<n, n>& P_out) const {
-    static_assert(asre_unsupported<Model>() == nullptr, "AsreFilter: Model must define sdc_drift(t, x) (or linear_form) and a linear observation");
+    static_assert(unsupported == nullptr,
+                  "AsreFilter: Model must define sdc_drift(t, x) (or linear_form) and a linear observation");
     const auto mi = Kokkos::subview(m, member, Kokkos::ALL, Kokkos::ALL);
     const auto Pi = Kokkos::subview(P, member, Kokkos::ALL, Kokkos::ALL);
     Vec<n> linearization_point = prior_mean, previous_updated = prior_mean;
@@ -94,15 +98,17 @@ struct AsreFilter {
       if (!kalman_update(observation_linearization(model, in.t, mk), in, mk, Pk, weighted_innovation))
         return Status::not_positive_definite;
       const SdcDrift<n> sdc = drift_sdc(model, in.t, linearization_point);
-      euler_predict(DriftLinearization<n>{sdc.A * mk + sdc.b, sdc.A,
-                                          noise_intensity(model.diffusion(in.t, linearization_point))},
-                    in.dt, mk, Pk);
+      euler_predict(
+          DriftLinearization<n>{sdc.A * mk + sdc.b, sdc.A, noise_intensity(model.diffusion(in.t, linearization_point))},
+          in.dt, mk, Pk);
       for (int i = 0; i < n; ++i) mi(i, it) = mk[i];
       for (int i = 0; i < n; ++i)
         for (int j = i; j < n; ++j) Pi(packed_index(n, i, j), it) = Pk(i, j);
       if (it > 0) {
         double largest = change(member, it);
-        for (int i = 0; i < n; ++i) largest = math::fabs(mk[i] - previous_updated[i]) > largest ? math::fabs(mk[i] - previous_updated[i]) : largest;
+        for (int i = 0; i < n; ++i)
+          largest =
+              math::fabs(mk[i] - previous_updated[i]) > largest ? math::fabs(mk[i] - previous_updated[i]) : largest;
         change(member, it) = largest;
       }
       previous_updated = mk;

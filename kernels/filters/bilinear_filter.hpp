@@ -27,7 +27,7 @@ struct BilinearFilter {
   static BilinearFilter create(const FilterConfig&, const Model&, long) { return {}; }
 
   KOKKOS_INLINE_FUNCTION Status step(const Model& model, int, const StepInput<p>& in, Vec<n>& m, Mat<n, n>& P) const {
-    static_assert(bilinear_filter_unsupported<Model>() == nullptr,
+    static_assert(unsupported == nullptr,
                   "BilinearFilter: Model must define drift_quadratic_polynomial(t) and a linear observation");
     Vec<p> weighted_innovation;
     if (!kalman_update(observation_linearization(model, in.t, m), in, m, P, weighted_innovation))

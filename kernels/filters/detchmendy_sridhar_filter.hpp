@@ -14,7 +14,8 @@ template <class Model, class MemSpace>
 struct DetchmendySridharFilter {
   static constexpr int n = Model::state_dim, p = Model::obs_dim;
   static constexpr const char* name = "EKF-DS";
-  static constexpr const char* description = "first-order filter, Detchmendy-Sridhar (row [13]: extra h'' covariance term)";
+  static constexpr const char* description =
+      "first-order filter, Detchmendy-Sridhar (row [13]: extra h'' covariance term)";
   static constexpr const char* unsupported = nullptr;
 
   static DetchmendySridharFilter create(const FilterConfig&, const Model&, long) { return {}; }

@@ -20,7 +20,7 @@ struct FilterBankStep {
   Model model;                                    // the filters' model
   BankScalar<Status, MemSpace> truth_status;      // non_finite once a truth escaped: not filtered, not scored
   FilterSlots<MemSpace, Filters...> slots;
-  bool record;                                    // the step ends at an output time: fill the snapshots
+  bool record;  // the step ends at an output time: fill the snapshots
 
   KOKKOS_INLINE_FUNCTION void operator()(const int member) const {
     constexpr int n = Model::state_dim, p = Model::obs_dim;

@@ -15,7 +15,7 @@ enum class Expectations {
 
 struct FilterConfig {
   Expectations qlf_expectations = Expectations::automatic;
-  int gh_nodes = 8;  // per axis; exact for polynomials of degree <= 2 gh_nodes - 1 in each variable
+  int gh_nodes = 8;              // per axis; exact for polynomials of degree <= 2 gh_nodes - 1 in each variable
   double asre_tolerance = 1e-6;  // on max over t of |m^[i](t) - m^[i-1](t)|_inf
   int asre_max_iterations = 30;
   /// Per member: the ASRE iterate to report. Empty: iterate to asre_max_iterations and record the changes

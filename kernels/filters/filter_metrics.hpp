@@ -12,14 +12,19 @@
 namespace kushner {
 
 /// Columns of MemberScores::out.
-enum MemberScoreColumn : int { member_mean_squared_error = 0, member_mean_nees = 1, member_mean_squared_reference_error = 2, num_member_score_columns = 3 };
+enum MemberScoreColumn : int {
+  member_mean_squared_error = 0,
+  member_mean_nees = 1,
+  member_mean_squared_reference_error = 2,
+  num_member_score_columns = 3
+};
 
 template <class MemSpace>
 struct MemberScores {
   BankVector<MemSpace> score;  // (member, ScoreColumn)
   BankScalar<Status, MemSpace> status, truth_status;
-  BankVector<MemSpace> out;    // (member, MemberScoreColumn)
-  double points;               // time points accumulated
+  BankVector<MemSpace> out;  // (member, MemberScoreColumn)
+  double points;             // time points accumulated
   bool has_reference;
 
   KOKKOS_INLINE_FUNCTION void operator()(const int member) const {

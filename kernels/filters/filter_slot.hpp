@@ -32,11 +32,11 @@ template <class Filter, class MemSpace>
 struct FilterSlot {
   Filter filter;
   bool enabled = false;
-  BankVector<MemSpace> m;                // (member, i)
-  BankSymmetric<MemSpace> P;             // (member, packed k)
-  BankScalar<Status, MemSpace> status;   // (member): ok until the member diverges; then m, P stay frozen
-  BankVector<MemSpace> score;            // (member, ScoreColumn)
-  BankVector<MemSpace> snapshot;         // (member, SnapshotColumn)
+  BankVector<MemSpace> m;               // (member, i)
+  BankSymmetric<MemSpace> P;            // (member, packed k)
+  BankScalar<Status, MemSpace> status;  // (member): ok until the member diverges; then m, P stay frozen
+  BankVector<MemSpace> score;           // (member, ScoreColumn)
+  BankVector<MemSpace> snapshot;        // (member, SnapshotColumn)
 };
 
 /// Scores a member's estimate m (covariance factor L, from semidefinite_cholesky) against the truth x.
@@ -69,7 +69,7 @@ KOKKOS_INLINE_FUNCTION void mark_unscored(const Slot& s, int member) {
 /// good m, P and is not updated again.
 template <class Model, class Filter, class MemSpace>
 KOKKOS_INLINE_FUNCTION void advance(const FilterSlot<Filter, MemSpace>& s, const Model& model, int member,
-                                   const StepInput<Model::obs_dim>& in, const Vec<Model::state_dim>& x, bool record) {
+                                    const StepInput<Model::obs_dim>& in, const Vec<Model::state_dim>& x, bool record) {
   constexpr int n = Model::state_dim;
   if (!s.enabled) return;
   if (s.status(member) != Status::ok) {

@@ -55,8 +55,8 @@ KOKKOS_INLINE_FUNCTION Mat<N, N> noise_intensity(const Mat<N, Q>& G) {
 /// receives S^{-1} (dy - h_hat dt), the V^{-1} (dy - h_hat dt) of the continuous equations, for filters
 /// whose covariance has dy terms.
 template <int N, int P>
-KOKKOS_INLINE_FUNCTION bool kalman_update(const ObservationLinearization<N, P>& obs, const StepInput<P>& in,
-                                          Vec<N>& m, Mat<N, N>& Pm, Vec<P>& weighted_innovation) {
+KOKKOS_INLINE_FUNCTION bool kalman_update(const ObservationLinearization<N, P>& obs, const StepInput<P>& in, Vec<N>& m,
+                                          Mat<N, N>& Pm, Vec<P>& weighted_innovation) {
   const Mat<N, P> PHt = Pm * transpose(obs.H);
   const Mat<P, P> S = in.V + (obs.H * PHt) * in.dt;
   Mat<P, P> L;

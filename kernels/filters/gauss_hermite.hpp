@@ -29,11 +29,16 @@ inline GaussHermiteRule make_gauss_hermite_rule(int order) {
   const double pim4 = 0.7511255444649425;  // pi^{-1/4}
   double z = 0.0;
   for (int i = 0; i < (n + 1) / 2; ++i) {
-    if (i == 0) z = std::sqrt(2.0 * n + 1.0) - 1.85575 * std::pow(2.0 * n + 1.0, -0.16667);
-    else if (i == 1) z -= 1.14 * std::pow(static_cast<double>(n), 0.426) / z;
-    else if (i == 2) z = 1.86 * z - 0.86 * rule.node[0];
-    else if (i == 3) z = 1.91 * z - 0.91 * rule.node[1];
-    else z = 2.0 * z - rule.node[i - 2];
+    if (i == 0)
+      z = std::sqrt(2.0 * n + 1.0) - 1.85575 * std::pow(2.0 * n + 1.0, -0.16667);
+    else if (i == 1)
+      z -= 1.14 * std::pow(static_cast<double>(n), 0.426) / z;
+    else if (i == 2)
+      z = 1.86 * z - 0.86 * rule.node[0];
+    else if (i == 3)
+      z = 1.91 * z - 0.91 * rule.node[1];
+    else
+      z = 2.0 * z - rule.node[i - 2];
     double pp = 0.0;
     for (int iteration = 0; iteration < 100; ++iteration) {
       double p1 = pim4, p2 = 0.0;

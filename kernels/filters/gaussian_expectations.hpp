@@ -16,9 +16,8 @@ namespace kushner {
 
 /// E_N[f], E_N[grad f] in closed form (ModelTraits<Model>::closed_form_expectations).
 template <class Model>
-KOKKOS_INLINE_FUNCTION GaussianDrift<Model::state_dim> closed_form_drift(const Model& model, double t,
-                                                                         const Vec<Model::state_dim>& m,
-                                                                         const Mat<Model::state_dim, Model::state_dim>& P) {
+KOKKOS_INLINE_FUNCTION GaussianDrift<Model::state_dim> closed_form_drift(
+    const Model& model, double t, const Vec<Model::state_dim>& m, const Mat<Model::state_dim, Model::state_dim>& P) {
   static_assert(ModelTraits<Model>::closed_form_expectations,
                 "closed_form_drift: Model needs gaussian_drift(t, m, P) or a polynomial drift");
   if constexpr (detail::has_gaussian_drift<Model>::value)

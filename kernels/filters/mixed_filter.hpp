@@ -24,13 +24,14 @@ template <class Model, class MemSpace>
 struct MixedFilter {
   static constexpr int n = Model::state_dim, p = Model::obs_dim;
   static constexpr const char* name = "MIXED";
-  static constexpr const char* description = "Basin's mixed filter: polynomial-filter mean, linearized Kalman-Bucy covariance";
+  static constexpr const char* description =
+      "Basin's mixed filter: polynomial-filter mean, linearized Kalman-Bucy covariance";
   static constexpr const char* unsupported = mixed_filter_unsupported<Model>();
 
   static MixedFilter create(const FilterConfig&, const Model&, long) { return {}; }
 
   KOKKOS_INLINE_FUNCTION Status step(const Model& model, int, const StepInput<p>& in, Vec<n>& m, Mat<n, n>& P) const {
-    static_assert(mixed_filter_unsupported<Model>() == nullptr, "MixedFilter: Model must have a polynomial drift and a linear observation");
+    static_assert(unsupported == nullptr, "MixedFilter: Model must have a polynomial drift and a linear observation");
     Vec<p> weighted_innovation;
     if (!kalman_update(observation_linearization_at_origin(model, in.t, m), in, m, P, weighted_innovation))
       return Status::not_positive_definite;
@@ -40,7 +41,8 @@ struct MixedFilter {
     return Status::ok;
   }
 
-  KOKKOS_INLINE_FUNCTION static Vec<n> polynomial_mean(const Model& model, double t, const Vec<n>& m, const Mat<n, n>& P) {
+  KOKKOS_INLINE_FUNCTION static Vec<n> polynomial_mean(const Model& model, double t, const Vec<n>& m,
+                                                       const Mat<n, n>& P) {
     if constexpr (ModelTraits<Model>::quadratic_polynomial)
       return gaussian_drift(drift_quadratic_polynomial(model, t), m, P).mean;
     else

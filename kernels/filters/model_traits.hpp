@@ -84,7 +84,8 @@ KOKKOS_INLINE_FUNCTION auto drift_power_polynomial(const Model& model, double t)
   if constexpr (detail::has_power_polynomial<Model>::value) {
     return model.drift_power_polynomial(t);
   } else {
-    static_assert(ModelTraits<Model>::linear, "drift_power_polynomial: Model has neither drift_power_polynomial(t) nor linear_form(t)");
+    static_assert(ModelTraits<Model>::linear,
+                  "drift_power_polynomial: Model has neither drift_power_polynomial(t) nor linear_form(t)");
     const auto lf = model.linear_form(t);
     auto poly = PowerPolynomial<n, 1>::zero();
     poly.a0 = lf.a0;
@@ -111,7 +112,8 @@ KOKKOS_INLINE_FUNCTION auto drift_quadratic_polynomial(const Model& model, doubl
 
 /// f(t, x) = A(x) x + b (seed 001 (4), with the known input b of Theorem 3 (ii)).
 template <class Model>
-KOKKOS_INLINE_FUNCTION SdcDrift<Model::state_dim> drift_sdc(const Model& model, double t, const Vec<Model::state_dim>& x) {
+KOKKOS_INLINE_FUNCTION SdcDrift<Model::state_dim> drift_sdc(const Model& model, double t,
+                                                            const Vec<Model::state_dim>& x) {
   if constexpr (detail::has_sdc_drift<Model>::value) {
     return model.sdc_drift(t, x);
   } else {

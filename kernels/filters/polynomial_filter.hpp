@@ -28,10 +28,12 @@ constexpr const char* polynomial_filter_unsupported() {
 template <class Model, int Degree>
 struct PolynomialStep {
   static constexpr int n = Model::state_dim, p = Model::obs_dim;
+  static constexpr const char* unsupported = polynomial_filter_unsupported<Model, Degree>();
 
   KOKKOS_INLINE_FUNCTION static Status step(const Model& model, const StepInput<p>& in, Vec<n>& m, Mat<n, n>& P) {
-    static_assert(polynomial_filter_unsupported<Model, Degree>() == nullptr,
-                  "PolynomialFilter: Model must define drift_power_polynomial(t) of low enough degree and a linear observation");
+    static_assert(
+        unsupported == nullptr,
+        "PolynomialFilter: Model must define drift_power_polynomial(t) of low enough degree and a linear observation");
     Vec<p> weighted_innovation;
     if (!kalman_update(observation_linearization(model, in.t, m), in, m, P, weighted_innovation))
       return Status::not_positive_definite;

@@ -8,7 +8,8 @@ namespace kushner {
 
 /// Componentwise powers, p = diag(P) (seed 002 (5)-(7)):
 ///   E[x^2] = p + m^2,  E[x^3] = 3 p m + m^3,  E[x^4] = 3 p^2 + 6 p m^2 + m^4;
-/// and E[d(x_j^k)/dx_j] = k E[x_j^(k-1)], so E_N[grad f] = sum_k k a_k diag(E[x^(k-1)]) (J3, J4 of seed 002 (10), (13)).
+/// and E[d(x_j^k)/dx_j] = k E[x_j^(k-1)], so E_N[grad f] = sum_k k a_k diag(E[x^(k-1)]) (J3, J4 of seed 002 (10),
+/// (13)).
 template <int N, int Degree>
 KOKKOS_INLINE_FUNCTION GaussianDrift<N> gaussian_drift(const PowerPolynomial<N, Degree>& poly, const Vec<N>& m,
                                                        const Mat<N, N>& P) {

@@ -25,13 +25,12 @@ Expectations resolve_qlf_expectations(Expectations requested) {
   constexpr bool closed = ModelTraits<Model>::closed_form_expectations;
   constexpr bool cubature = Model::state_dim <= max_cubature_dim;
   if (requested == Expectations::automatic) return closed ? Expectations::closed : Expectations::cubature;
-  KUSHNER_INPUT_REQUIRE(requested != Expectations::closed || closed,
-                        "--qlf-expectations: model '" << Model::name
-                                                      << "' has no closed-form Gaussian expectations (use cubature)");
+  KUSHNER_INPUT_REQUIRE(
+      requested != Expectations::closed || closed,
+      "--qlf-expectations: model '" << Model::name << "' has no closed-form Gaussian expectations (use cubature)");
   KUSHNER_INPUT_REQUIRE(requested != Expectations::cubature || cubature,
-                        "--qlf-expectations: cubature is limited to state_dim <= " << max_cubature_dim << " (model '"
-                                                                                    << Model::name << "' has "
-                                                                                    << Model::state_dim << ")");
+                        "--qlf-expectations: cubature is limited to state_dim <= "
+                            << max_cubature_dim << " (model '" << Model::name << "' has " << Model::state_dim << ")");
   return requested;
 }
 
@@ -56,7 +55,7 @@ struct QuasiLinearFilter {
   }
 
   KOKKOS_INLINE_FUNCTION Status step(const Model& model, int, const StepInput<p>& in, Vec<n>& m, Mat<n, n>& P) const {
-    static_assert(qlf_unsupported<Model>() == nullptr, "QuasiLinearFilter: Model has no usable Gaussian expectations");
+    static_assert(unsupported == nullptr, "QuasiLinearFilter: Model has no usable Gaussian expectations");
     ObservationLinearization<n, p> obs;
     if constexpr (ModelTraits<Model>::linear_observation) {
       obs = observation_linearization(model, in.t, m);  // E_N[h] = h(m), E_N[grad h] = H exactly

@@ -33,7 +33,8 @@ template <class Model, class MemSpace>
 struct SecondOrderFilter {
   static constexpr int n = Model::state_dim, p = Model::obs_dim;
   static constexpr const char* name = "SOF";
-  static constexpr const char* description = "second-order filter, Schwartz (row [9], Hessian terms in mean and covariance)";
+  static constexpr const char* description =
+      "second-order filter, Schwartz (row [9], Hessian terms in mean and covariance)";
   static constexpr const char* unsupported = nullptr;  // every continuous-time model has its Hessians
 
   static SecondOrderFilter create(const FilterConfig&, const Model&, long) { return {}; }
