@@ -34,11 +34,11 @@ struct CarBase : InitialLaw<2> {
 
   template <class Visitor>
   void parameters(Visitor&& visit) {
-    visit("v", v, "velocity");
-    visit("l", l, "wheelbase");
-    visit("u", u, "steering rate (constant, known)");
+    visit("v", v, "velocity (seed 002: 1)");
+    visit("l", l, "wheelbase (seed 002: 1)");
+    visit("u", u, "steering rate, constant and known (seed 002: 0.05)");
     visit("q", q, "process noise intensity on both angles (paper: 0)");
-    visit("r", r, "observation noise intensity of both angles");
+    visit("r", r, "observation noise intensity of both angles (seed 002: V = I)");
     initial_law_parameters(visit);
   }
 
