@@ -44,11 +44,18 @@ install_packages() {
 # named here and the snapshot/mirror the machine already uses is kept.
 enable_deb_src() {
   local list=/etc/apt/sources.list.d/kushner-deb-src.sources
-  [ -f "$list" ] && return
+  [ -f "$list" ] || [ -f "${list%.sources}.list" ] && return
   local src=/etc/apt/sources.list.d/debian.sources
-  [ -f "$src" ] || die "no $src to derive deb-src entries from; add deb-src lines for trilinos by hand"
-  say "enabling deb-src entries ($list)"
-  sed 's/^Types: deb$/Types: deb-src/' "$src" | as_root tee "$list" >/dev/null
+  if [ -f "$src" ]; then
+    say "enabling deb-src entries ($list)"
+    sed 's/^Types: deb$/Types: deb-src/' "$src" | as_root tee "$list" >/dev/null
+  elif [ -f /etc/apt/sources.list ] && grep -q '^deb ' /etc/apt/sources.list; then
+    list=/etc/apt/sources.list.d/kushner-deb-src.list
+    say "enabling deb-src entries ($list)"
+    sed -n 's/^deb /deb-src /p' /etc/apt/sources.list | as_root tee "$list" >/dev/null
+  else
+    die "no apt sources to derive deb-src entries from; add deb-src lines for trilinos by hand"
+  fi
   as_root apt-get update -qq
 }
 
