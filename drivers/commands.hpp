@@ -1,6 +1,7 @@
 #pragma once
 // The subcommands of `kushner`. Each validates all its input before opening any output and throws
 // InputError for bad input; main() turns that into one line on stderr and exit code 2.
+#include "drivers/filter_options.hpp"
 #include "drivers/run_metadata.hpp"
 #include "drivers/run_options.hpp"
 
@@ -8,6 +9,12 @@ namespace kushner {
 
 /// `kushner simulate`: the bank of truths; writes summary.json and timeseries.csv.
 int run_simulate(const RunOptions& options, const RunContext& context);
+
+/// `kushner filter`: the bank of truths and filters; writes summary.json and timeseries.csv.
+int run_filter(const FilterOptions& options, const RunContext& context);
+
+/// `kushner filters`: every filter and the models it supports (or why not).
+int run_filters_list(bool json);
 
 /// `kushner models`: the built-in models and their parameters.
 int run_models(bool json);

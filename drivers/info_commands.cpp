@@ -1,8 +1,10 @@
 #include "drivers/backend.hpp"
 #include "drivers/commands.hpp"
+#include "drivers/filter_selection.hpp"
 #include "models/registry.hpp"
 
 #include <iostream>
+#include <map>
 
 namespace kushner {
 
@@ -19,6 +21,51 @@ int run_models(bool json) {
     for (const auto& p : m["parameters"])
       std::cout << "    --set " << p["name"].get<std::string>() << "=" << p["default"].dump() << "  "
                 << p["description"].get<std::string>() << "\n";
+  }
+  return 0;
+}
+
+/// Whether `kushner filters` lists this type: a name with several dimensions is listed at its default.
+template <class Model>
+constexpr bool listed_once() {
+  if constexpr (dimension_choice<Model>::selectable)
+    return Model::state_dim == dimension_choice<Model>::default_dim;
+  else
+    return true;
+}
+
+int run_filters_list(bool json) {
+  // filter name -> (supported models, refused models with the reason), in report order
+  const std::vector<std::string> names = all_filter_names();
+  std::map<std::string, nlohmann::json> supported, refused;
+  std::map<std::string, std::string> descriptions;
+  detail::for_each_model_type([&](auto* tag) {
+    using Model = std::remove_pointer_t<decltype(tag)>;
+    if constexpr (!Model::discrete_time && listed_once<Model>()) {
+      for (const auto& f : filter_support<Model>()) {
+        descriptions[f.name] = f.description;
+        if (f.unsupported == nullptr) supported[f.name].push_back(Model::name);
+        else refused[f.name].push_back({{"model", Model::name}, {"reason", f.unsupported}});
+      }
+    }
+  });
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& name : names) {
+    nlohmann::json s = supported.count(name) ? supported[name] : nlohmann::json::array();
+    nlohmann::json r = refused.count(name) ? refused[name] : nlohmann::json::array();
+    std::sort(s.begin(), s.end());
+    list.push_back({{"name", name}, {"description", descriptions[name]}, {"models", s}, {"refuses", r}});
+  }
+  if (json) {
+    std::cout << list.dump(2) << "\n";
+    return 0;
+  }
+  for (const auto& f : list) {
+    std::cout << f["name"].get<std::string>() << "  " << f["description"].get<std::string>() << "\n    models:";
+    for (const auto& m : f["models"]) std::cout << " " << m.get<std::string>();
+    std::cout << "\n";
+    for (const auto& r : f["refuses"])
+      std::cout << "    not " << r["model"].get<std::string>() << ": " << r["reason"].get<std::string>() << "\n";
   }
   return 0;
 }

@@ -16,7 +16,9 @@ namespace {
 struct Options {
   bool version = false;
   RunOptions simulate;
+  FilterOptions filter;
   bool models_json = false;
+  bool filters_json = false;
 };
 
 std::unique_ptr<CLI::App> make_app(Options& o) {
@@ -27,8 +29,11 @@ std::unique_ptr<CLI::App> make_app(Options& o) {
   app->require_subcommand(0, 1);
   app->add_flag("--version", o.version, "print versions, the backend and its threads or device");
   add_run_options(*app->add_subcommand("simulate", "simulate the bank of truths and observations"), o.simulate);
+  add_filter_options(*app->add_subcommand("filter", "run the bank of truths and filters side by side"), o.filter);
   app->add_subcommand("models", "list the built-in models and their parameters")
       ->add_flag("--json", o.models_json, "as JSON");
+  app->add_subcommand("filters", "list the filters and the models each supports")
+      ->add_flag("--json", o.filters_json, "as JSON");
   return app;
 }
 
@@ -45,7 +50,9 @@ std::unique_ptr<CLI::App> parse(int argc, char** argv, Options& o) {
     return nullptr;
   }
   const auto subcommands = app->get_subcommands();
-  if (subcommands.empty() || subcommands[0]->get_option("--config")->count() == 0) return app;
+  if (subcommands.empty()) return app;
+  const CLI::Option* config = subcommands[0]->get_option_no_throw("--config");  // `models` has none
+  if (config == nullptr || config->count() == 0) return app;
   CLI::App* sub = subcommands[0];
   const std::string path = sub->get_option("--config")->as<std::string>();
   std::vector<std::string> expanded = config_file_arguments(path, *sub);
@@ -66,6 +73,12 @@ int run(int argc, char** argv) {
   RunContext context{command_line(argc, argv), 0, ""};
   if (o.version) return run_version();
   if (app->got_subcommand("models")) return run_models(o.models_json);
+  if (app->got_subcommand("filters")) return run_filters_list(o.filters_json);
+  if (app->got_subcommand("filter")) {
+    context.seed = static_cast<std::uint32_t>(o.filter.run.seed);
+    context.backend = selected_backend();
+    return run_filter(o.filter, context);
+  }
   if (app->got_subcommand("simulate")) {
     context.seed = static_cast<std::uint32_t>(o.simulate.seed);
     context.backend = selected_backend();

@@ -26,6 +26,39 @@ KOKKOS_INLINE_FUNCTION bool cholesky(const Mat<N, N>& A, Mat<N, N>& L) {
   return true;
 }
 
+/// How a symmetric matrix factored by semidefinite_cholesky turned out.
+enum class Definiteness { positive_definite, singular, indefinite };
+
+/// Lower-triangular L with L L^T = A for a positive semidefinite A: a pivot within `tolerance` times the
+/// largest diagonal entry of zero counts as zero (its column of L is zero), so singular covariances (a fixed
+/// initial state, no process noise) still factor. A pivot below minus that, or a non-finite one, means A is
+/// indefinite; L is then partial.
+template <int N>
+KOKKOS_INLINE_FUNCTION Definiteness semidefinite_cholesky(const Mat<N, N>& A, Mat<N, N>& L, double tolerance) {
+  double scale = 0.0;
+  for (int i = 0; i < N; ++i) scale = A(i, i) > scale ? A(i, i) : scale;
+  const double zero = tolerance * scale;
+  L = Mat<N, N>::zero();
+  Definiteness result = Definiteness::positive_definite;
+  for (int j = 0; j < N; ++j) {
+    double d = A(j, j);
+    for (int k = 0; k < j; ++k) d -= L(j, k) * L(j, k);
+    if (!math::is_finite(d) || d < -zero) return Definiteness::indefinite;
+    if (d <= zero) {
+      result = Definiteness::singular;
+      continue;
+    }
+    const double ljj = math::sqrt(d);
+    L(j, j) = ljj;
+    for (int i = j + 1; i < N; ++i) {
+      double s = A(i, j);
+      for (int k = 0; k < j; ++k) s -= L(i, k) * L(j, k);
+      L(i, j) = s / ljj;
+    }
+  }
+  return result;
+}
+
 /// Solves L L^T x = b for x, given the Cholesky factor L.
 template <int N>
 KOKKOS_INLINE_FUNCTION Vec<N> cholesky_solve(const Mat<N, N>& L, const Vec<N>& b) {

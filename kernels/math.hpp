@@ -40,6 +40,14 @@ KOKKOS_INLINE_FUNCTION bool is_finite(double v) {
   return (bits & 0x7ff0000000000000ull) != 0x7ff0000000000000ull;
 }
 
+/// A quiet NaN, built from its bit pattern: std::numeric_limits is not device-callable everywhere.
+KOKKOS_INLINE_FUNCTION double quiet_nan() {
+  const std::uint64_t bits = 0x7ff8000000000000ull;
+  double v;
+  std::memcpy(&v, &bits, sizeof v);
+  return v;
+}
+
 KOKKOS_INLINE_FUNCTION double square(double v) { return v * v; }
 
 /// log(cosh(x)) without overflow for large |x|.

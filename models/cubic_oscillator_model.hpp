@@ -8,6 +8,7 @@
 // prior N(0, I). Even so, a few percent of noisy paths escape over long horizons: such members are counted
 // as diverged, not averaged in.
 #include "kernels/small_matrix.hpp"
+#include "models/drift_forms.hpp"
 #include "models/initial_law.hpp"
 
 namespace kushner {
@@ -15,6 +16,7 @@ namespace kushner {
 struct CubicOscillatorModel : InitialLaw<2> {
   static constexpr int state_dim = 2, obs_dim = 2, noise_dim = 1, control_dim = 0;
   static constexpr bool discrete_time = false;
+  static constexpr bool linear_observation = true;
   static constexpr const char* name = "cubic-oscillator";
   static constexpr const char* description =
       "Sunahara 1968 Example 2: dx1 = x2 dt, dx2 = (-x2 - x1 + x1^3/8) dt + q dw, dy = x dt + r dv";
@@ -53,6 +55,24 @@ struct CubicOscillatorModel : InitialLaw<2> {
   KOKKOS_INLINE_FUNCTION Mat<2, 2> observation_jacobian(double, const Vec<2>&) const { return Mat<2, 2>::identity(); }
   KOKKOS_INLINE_FUNCTION Mat<2, 2> observation_hessian(double, const Vec<2>&, int) const { return Mat<2, 2>::zero(); }
   KOKKOS_INLINE_FUNCTION Mat<2, 2> observation_noise(double) const { return Mat<2, 2>::diagonal(r); }
+
+  /// Seed 000 (6.14) and the unnumbered B(t) after it: E_N[f] and E_N[grad f] for x ~ N(m, P).
+  KOKKOS_INLINE_FUNCTION GaussianDrift<2> gaussian_drift(double, const Vec<2>& m, const Mat<2, 2>& P) const {
+    const double m1 = m[0], m2 = m[1], p11 = P(0, 0);
+    const double beta = -1.0 + 3.0 / 8.0 * m1 * m1 + 3.0 / 8.0 * p11;
+    return {{{m2, -m2 - m1 + m1 * m1 * m1 / 8.0 + 3.0 / 8.0 * p11 * m1}}, {{{0.0, 1.0}, {beta, -1.0}}}};
+  }
+  /// f = a1 x + a3 x^3 componentwise: a1 = [[0, 1], [-1, -1]], a3 = [[0, 0], [1/8, 0]] (/work/notes/filters.md 2.2).
+  KOKKOS_INLINE_FUNCTION PowerPolynomial<2, 3> drift_power_polynomial(double) const {
+    auto poly = PowerPolynomial<2, 3>::zero();
+    poly.coefficient[1] = Mat<2, 2>{{{0.0, 1.0}, {-1.0, -1.0}}};
+    poly.coefficient[3](1, 0) = 1.0 / 8.0;
+    return poly;
+  }
+  /// f = A(x) x with A(x) = [[0, 1], [-1 + x1^2 / 8, -1]]: the ASRE factorization.
+  KOKKOS_INLINE_FUNCTION SdcDrift<2> sdc_drift(double, const Vec<2>& x) const {
+    return {{{{0.0, 1.0}, {-1.0 + x[0] * x[0] / 8.0, -1.0}}}, Vec<2>::zero()};
+  }
 };
 
 }  // namespace kushner

@@ -24,7 +24,7 @@ struct InitialLaw {
     v("x0_mean", x0_mean, "mean of the truths' initial state");
     v("x0_cov", x0_cov, "covariance of the truths' initial state (positive semidefinite; 0 = fixed start)");
     v("prior_mean", prior_mean, "filters' initial estimate");
-    v("prior_cov", prior_cov, "filters' initial covariance (positive definite)");
+    v("prior_cov", prior_cov, "filters' initial covariance (positive semidefinite)");
   }
 };
 

@@ -5,6 +5,7 @@
 // R = 0.5 I, a0 = c0 = 0, x(0) ~ N(1, 0.1 I) for truths and prior alike. All matrices are settable.
 // The observation has the state's dimension; a partial observation is a row of C set to zero.
 #include "kernels/small_matrix.hpp"
+#include "models/drift_forms.hpp"
 #include "models/initial_law.hpp"
 
 namespace kushner {
@@ -56,6 +57,9 @@ struct LinearModel : InitialLaw<N> {
   KOKKOS_INLINE_FUNCTION Mat<N, N> observation_jacobian(double, const Vec<N>&) const { return C; }
   KOKKOS_INLINE_FUNCTION Mat<N, N> observation_hessian(double, const Vec<N>&, int) const { return Mat<N, N>::zero(); }
   KOKKOS_INLINE_FUNCTION Mat<N, N> observation_noise(double) const { return R; }
+
+  /// The coefficients the Kalman-Bucy filter reads.
+  KOKKOS_INLINE_FUNCTION LinearForm<N, N> linear_form(double) const { return {a0, A, c0, C}; }
 };
 
 }  // namespace kushner

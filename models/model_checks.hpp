@@ -76,7 +76,9 @@ struct has_validate<Model, std::void_t<decltype(std::declval<const Model&>().val
 template <class Model>
 void validate_model(const Model& model) {
   check_covariance("x0_cov", model.x0_cov, /*allow_singular=*/true);
-  check_covariance("prior_cov", model.prior_cov, /*allow_singular=*/false);
+  // Singular priors are allowed (seed 002's car starts its filters from P(0) = [[100, 10], [10, 1]]): no
+  // filter inverts P (kernels/filters/filter_step.hpp).
+  check_covariance("prior_cov", model.prior_cov, /*allow_singular=*/true);
   if constexpr (!Model::discrete_time) {
     const auto r = model.observation_noise(0.0);
     check_covariance("observation noise R R^T", r * transpose(r), /*allow_singular=*/false);

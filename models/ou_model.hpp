@@ -3,6 +3,7 @@
 //   dx = -theta (x - mu) dt + sigma dw,   dy = x dt + r dv.
 // E[x(t)] = mu + (m0 - mu) e^{-theta t},  Var[x(t)] = P0 e^{-2 theta t} + sigma^2 (1 - e^{-2 theta t}) / (2 theta).
 #include "kernels/small_matrix.hpp"
+#include "models/drift_forms.hpp"
 #include "models/initial_law.hpp"
 
 namespace kushner {
@@ -35,6 +36,11 @@ struct OuModel : InitialLaw<1> {
   KOKKOS_INLINE_FUNCTION Mat<1, 1> observation_jacobian(double, const Vec<1>&) const { return {{{1.0}}}; }
   KOKKOS_INLINE_FUNCTION Mat<1, 1> observation_hessian(double, const Vec<1>&, int) const { return {{{0.0}}}; }
   KOKKOS_INLINE_FUNCTION Mat<1, 1> observation_noise(double) const { return {{{r}}}; }
+
+  /// -theta (x - mu) = theta mu - theta x: the coefficients the Kalman-Bucy filter reads.
+  KOKKOS_INLINE_FUNCTION LinearForm<1, 1> linear_form(double) const {
+    return {{{theta * mu}}, {{{-theta}}}, {{0.0}}, {{{1.0}}}};
+  }
 };
 
 }  // namespace kushner

@@ -4,6 +4,7 @@
 // x(0) ~ N(1, 1) for the truths and the filters' prior alike.
 #include "kernels/math.hpp"
 #include "kernels/small_matrix.hpp"
+#include "models/drift_forms.hpp"
 #include "models/initial_law.hpp"
 
 namespace kushner {
@@ -11,6 +12,7 @@ namespace kushner {
 struct SineModel : InitialLaw<1> {
   static constexpr int state_dim = 1, obs_dim = 1, noise_dim = 1, control_dim = 0;
   static constexpr bool discrete_time = false;
+  static constexpr bool linear_observation = true;
   static constexpr const char* name = "sine";
   static constexpr const char* description = "Sunahara 1968 Example 1: dx = -sin(x) dt + q dw, dy = x dt + r dv";
   using Control = Vec<control_dim>;
@@ -38,6 +40,18 @@ struct SineModel : InitialLaw<1> {
   KOKKOS_INLINE_FUNCTION Mat<1, 1> observation_jacobian(double, const Vec<1>&) const { return {{{1.0}}}; }
   KOKKOS_INLINE_FUNCTION Mat<1, 1> observation_hessian(double, const Vec<1>&, int) const { return {{{0.0}}}; }
   KOKKOS_INLINE_FUNCTION Mat<1, 1> observation_noise(double) const { return {{{r}}}; }
+
+  /// Seed 000 (6.4)-(6.5): E[-sin x] = -sin(m) e^{-p/2}, E[-cos x] = -cos(m) e^{-p/2} for x ~ N(m, p).
+  KOKKOS_INLINE_FUNCTION GaussianDrift<1> gaussian_drift(double, const Vec<1>& m, const Mat<1, 1>& P) const {
+    const double damping = math::exp(-0.5 * P(0, 0));
+    return {{{-math::sin(m[0]) * damping}}, {{{-math::cos(m[0]) * damping}}}};
+  }
+  /// -sin x = A(x) x with A(x) = -sin(x) / x (-1 at 0): the ASRE factorization (/work/notes/filters.md 2.1).
+  KOKKOS_INLINE_FUNCTION SdcDrift<1> sdc_drift(double, const Vec<1>& x) const {
+    const double v = x[0];
+    const double sinc = math::fabs(v) < 1e-4 ? 1.0 - v * v / 6.0 : math::sin(v) / v;
+    return {{{{-sinc}}}, {{0.0}}};
+  }
 };
 
 }  // namespace kushner

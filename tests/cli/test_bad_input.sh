@@ -19,13 +19,13 @@ expect_refused() {  # expect_refused "expected message fragment" args...
 }
 
 fresh="$work/fresh"
-expect_refused "unknown model 'sin' (known: clark-linear, cubic-oscillator, linear, ou, sine)" simulate --model sin --out "$fresh"
+expect_refused "unknown model 'sin' (known: benes, car, car-taylor3, clark-linear, cubic-oscillator, linear, ou, sine, terpolymer)" simulate --model sin --out "$fresh"
 expect_refused "--dt: must be positive (got 0)" simulate --dt 0 --out "$fresh"
 expect_refused "--dt: must be positive (got -1)" simulate --dt -1 --out "$fresh"
 expect_refused "--members: must be positive (got 0)" simulate --members 0 --out "$fresh"
 expect_refused "--T: must be a whole number of --dt steps" simulate --T 1 --dt 0.3 --out "$fresh"
 expect_refused "--seed: must be in 0 .. 4294967295" simulate --seed -3 --out "$fresh"
-expect_refused "prior_cov: not positive definite (pivot 1)" simulate --set prior_cov=-1 --out "$fresh"
+expect_refused "prior_cov: not positive semidefinite (smallest eigenvalue -1)" simulate --set prior_cov=-1 --out "$fresh"
 expect_refused "model 'sine' has no parameter 'qq'" simulate --set qq=1 --out "$fresh"
 expect_refused "--members" simulate --members lots --out "$fresh"
 printf 'members = 10\nthis line is not toml or ini\n' >"$work/bad.toml"

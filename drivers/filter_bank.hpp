@@ -1,0 +1,242 @@
+#pragma once
+// The bank of truths and filters on one execution space: the truths (drivers/simulate_ensemble.hpp), every
+// filter the model supports as a slot (kernels/filters/filter_slot.hpp) with the selected ones allocated and
+// enabled, the fused step kernel, and the reductions behind the reported metrics. Reductions go through
+// ensemble_moments (fixed-order blocks), so every number is the same on any number of threads.
+#include "drivers/reference_mean.hpp"
+#include "drivers/simulate_ensemble.hpp"
+#include "kernels/ensemble_moments.hpp"
+#include "kernels/filters/filter_bank_step.hpp"
+#include "kernels/filters/filter_list.hpp"
+#include "kernels/filters/filter_metrics.hpp"
+
+#include <Kokkos_Core.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace kushner {
+
+/// A mean over members with its Monte Carlo standard error.
+struct Estimate {
+  double value = 0.0, standard_error = 0.0;
+  long members = 0;  // how many members it averages
+};
+
+/// One filter at one output time.
+struct FilterSnapshot {
+  double rmse_truth = 0.0;  // sqrt of the mean over scored members of |m - x|^2
+  double rmse_truth_se = 0.0;
+  double nees = 0.0;  // mean over members with positive definite P
+  double nees_se = 0.0;
+  double rmse_ref = 0.0;  // against the reference mean, when there is one
+  long diverged = 0;      // members whose filter has diverged by now (their truth not escaped)
+};
+
+/// One filter over the whole run: time-and-ensemble means over the members scored at the end.
+struct FilterScores {
+  Estimate rmse_truth;  // root of the time-and-ensemble mean squared error; SE by the delta method
+  Estimate nees;        // mean NEES (per member, the time average over points where P is positive definite)
+  Estimate rmse_ref;
+  long diverged = 0, not_positive_definite = 0, non_finite = 0;  // among members whose truth did not escape
+};
+
+template <class ExecSpace, class Model>
+class FilterBank {
+ public:
+  using MemSpace = typename ExecSpace::memory_space;
+  static constexpr int n = Model::state_dim, p = Model::obs_dim;
+
+ private:
+  template <class Tuple>
+  struct Kernels;
+  template <class... Filters>
+  struct Kernels<std::tuple<Filters...>> {
+    using Slots = FilterSlots<MemSpace, Filters...>;
+    using Step = FilterBankStep<Model, MemSpace, Filters...>;
+    using Initial = FilterBankInitialScore<Model, MemSpace, Filters...>;
+    using Reference = FilterBankReferenceScore<Model, MemSpace, BankVector<MemSpace>, Filters...>;
+  };
+  using K = Kernels<SupportedFilters<Model, MemSpace>>;
+
+ public:
+  /// `filters`: names from select_filters<Model>() (supported, report order). The truths follow truth_model,
+  /// the filters filter_model (the same in a run; tests set them apart to show that a test can fail).
+  FilterBank(const ExecSpace& space, const Model& truth_model, const Model& filter_model, long members,
+             std::uint32_t seed, const std::vector<std::string>& filters, const FilterConfig& config)
+      : space_(space),
+        truth_model_(truth_model),
+        filter_model_(filter_model),
+        members_(members),
+        seed_(seed),
+        truths_(space, truth_model, members, seed),
+        truth_status_("kushner::truth_status", members) {
+    for (const auto& name : filters) {
+      bool found = false;
+      for_each_slot([&](auto& slot) {
+        using Filter = decltype(slot.filter);
+        if (name != Filter::name) return;
+        found = true;
+        slot.enabled = true;
+        slot.filter = Filter::create(config, filter_model, members);
+        slot.m = BankVector<MemSpace>(std::string("kushner::m_") + Filter::name, members, n);
+        slot.P = BankSymmetric<MemSpace>(std::string("kushner::P_") + Filter::name, members, packed_size(n));
+        slot.status = BankScalar<Status, MemSpace>(std::string("kushner::status_") + Filter::name, members);
+        slot.score = BankVector<MemSpace>(std::string("kushner::score_") + Filter::name, members, num_score_columns);
+        slot.snapshot =
+            BankVector<MemSpace>(std::string("kushner::snapshot_") + Filter::name, members, num_snapshot_columns);
+        fill_prior(slot.m, slot.P);
+      });
+      KUSHNER_REQUIRE(found, "filter '" << name << "' is not supported by model " << Model::name);
+    }
+    Kokkos::parallel_for("kushner::filter_bank_initial_score", Kokkos::RangePolicy<ExecSpace>(space_, 0, members_),
+                         typename K::Initial{truths_.state(), slots_});
+  }
+
+  /// Scores every filter against `reference` from now on (call before the first step).
+  void set_reference(ReferenceMean<MemSpace>* reference) {
+    reference_ = reference;
+    if (reference_) score_reference(true);
+  }
+
+  /// Step k, over [k dt, (k + 1) dt]; `record`: (k + 1) dt is an output time.
+  void step(long k, double dt, bool record) {
+    const auto step = static_cast<std::uint32_t>(k);
+    typename K::Step kernel{EulerMaruyamaTruthStep<Model, MemSpace>{truth_model_, truths_.state(),
+                                                                    truths_.observations(), k * dt, dt, seed_, step},
+                            filter_model_, truth_status_, slots_, record};
+    Kokkos::parallel_for("kushner::filter_bank_step", Kokkos::RangePolicy<ExecSpace>(space_, 0, members_), kernel);
+    if (reference_) {
+      reference_->advance(k, k * dt, dt, truths_.observations());
+      score_reference(record);
+    }
+  }
+
+  const TruthBank<ExecSpace, Model>& truths() const { return truths_; }
+  /// (member): non_finite once the member's truth escaped to infinity.
+  const BankScalar<Status, MemSpace>& truth_status() const { return truth_status_; }
+
+  /// Calls f(slot) with the slot of filter `name` (a selected one).
+  template <class F>
+  void with_slot(const std::string& name, F&& f) const {
+    bool found = false;
+    for_each_slot([&](const auto& slot) {
+      if (slot.enabled && name == decltype(slot.filter)::name) {
+        found = true;
+        f(slot);
+      }
+    });
+    KUSHNER_REQUIRE(found, "filter '" << name << "' is not in this bank");
+  }
+
+  /// The slot of filter type Filter (one the model supports).
+  template <template <class, class> class Filter>
+  const FilterSlot<Filter<Model, MemSpace>, MemSpace>& slot() const {
+    return static_cast<const FilterSlot<Filter<Model, MemSpace>, MemSpace>&>(slots_);
+  }
+
+  /// Metrics of filter `name` at the latest output time.
+  FilterSnapshot snapshot(const std::string& name) const {
+    FilterSnapshot s;
+    with_slot(name, [&](const auto& slot) {
+      const Estimate rmse = root_mean(slot.snapshot, snapshot_squared_error);
+      const Estimate nees = mean(slot.snapshot, snapshot_nees);
+      s.rmse_truth = rmse.value;
+      s.rmse_truth_se = rmse.standard_error;
+      s.nees = nees.value;
+      s.nees_se = nees.standard_error;
+      s.rmse_ref = reference_ ? root_mean(slot.snapshot, snapshot_reference_squared_error).value : std::nan("");
+      s.diverged = count_status(space_, slot.status, Status::not_positive_definite, truth_status_) +
+                   count_status(space_, slot.status, Status::non_finite, truth_status_);
+    });
+    return s;
+  }
+
+  /// Metrics of filter `name` over the run so far: `points` time points have been scored (steps + 1).
+  FilterScores scores(const std::string& name, long points) const {
+    FilterScores s;
+    with_slot(name, [&](const auto& slot) {
+      BankVector<MemSpace> per_member("kushner::member_scores", members_, num_member_score_columns);
+      Kokkos::parallel_for("kushner::member_scores", Kokkos::RangePolicy<ExecSpace>(space_, 0, members_),
+                           MemberScores<MemSpace>{slot.score, slot.status, truth_status_, per_member,
+                                                  static_cast<double>(points), reference_ != nullptr});
+      s.rmse_truth = root_mean(per_member, member_mean_squared_error);
+      s.nees = mean(per_member, member_mean_nees);
+      s.rmse_ref = root_mean(per_member, member_mean_squared_reference_error);
+      s.not_positive_definite = count_status(space_, slot.status, Status::not_positive_definite, truth_status_);
+      s.non_finite = count_status(space_, slot.status, Status::non_finite, truth_status_);
+      s.diverged = s.not_positive_definite + s.non_finite;
+    });
+    return s;
+  }
+
+  /// Members whose truth escaped to infinity (left out of every metric).
+  long truths_escaped() const { return count_status(space_, truth_status_, Status::non_finite); }
+
+ private:
+  template <class F>
+  void for_each_slot(F&& f) {
+    for_each_slot_impl(f, static_cast<SupportedFilters<Model, MemSpace>*>(nullptr));
+  }
+  template <class F>
+  void for_each_slot(F&& f) const {
+    for_each_slot_impl(f, static_cast<SupportedFilters<Model, MemSpace>*>(nullptr));
+  }
+  template <class F, class... Filters>
+  void for_each_slot_impl(F& f, std::tuple<Filters...>*) {
+    (f(static_cast<FilterSlot<Filters, MemSpace>&>(slots_)), ...);
+  }
+  template <class F, class... Filters>
+  void for_each_slot_impl(F& f, std::tuple<Filters...>*) const {
+    (f(static_cast<const FilterSlot<Filters, MemSpace>&>(slots_)), ...);
+  }
+
+  void fill_prior(const BankVector<MemSpace>& m, const BankSymmetric<MemSpace>& P) const {
+    const auto mh = Kokkos::create_mirror_view(m);
+    const auto Ph = Kokkos::create_mirror_view(P);
+    for (long member = 0; member < members_; ++member) {
+      for (int i = 0; i < n; ++i) mh(member, i) = filter_model_.prior_mean[i];
+      for (int i = 0; i < n; ++i)
+        for (int j = i; j < n; ++j) Ph(member, packed_index(n, i, j)) = filter_model_.prior_cov(i, j);
+    }
+    Kokkos::deep_copy(m, mh);
+    Kokkos::deep_copy(P, Ph);
+  }
+
+  void score_reference(bool record) {
+    Kokkos::parallel_for("kushner::filter_bank_reference_score", Kokkos::RangePolicy<ExecSpace>(space_, 0, members_),
+                         typename K::Reference{reference_->mean(), truth_status_, slots_, record});
+  }
+
+  template <class View>
+  EnsembleMoments column_moments(const View& x, int column) const {
+    return ensemble_moments(space_, Kokkos::subview(x, Kokkos::ALL, std::make_pair(column, column + 1)));
+  }
+  template <class View>
+  Estimate mean(const View& x, int column) const {
+    const EnsembleMoments mo = column_moments(x, column);
+    const long count = members_ - mo.non_finite;
+    return {mo.mean[0], count > 1 ? std::sqrt(mo.variance[0] / count) : std::nan(""), count};
+  }
+  /// sqrt of a mean, with the delta-method standard error se(mean) / (2 sqrt(mean)).
+  template <class View>
+  Estimate root_mean(const View& x, int column) const {
+    const Estimate m = mean(x, column);
+    const double root = std::sqrt(m.value);
+    return {root, m.standard_error / (2.0 * root), m.members};
+  }
+
+  ExecSpace space_;
+  Model truth_model_, filter_model_;
+  long members_;
+  std::uint32_t seed_;
+  TruthBank<ExecSpace, Model> truths_;
+  BankScalar<Status, MemSpace> truth_status_;
+  typename K::Slots slots_;
+  ReferenceMean<MemSpace>* reference_ = nullptr;
+};
+
+}  // namespace kushner

@@ -1,0 +1,58 @@
+#pragma once
+// `--filters` on the command line: names to the filters a model supports, in report order, or one clear
+// InputError line ("filter POLY3 does not support model 'car' (drift is not polynomial)").
+#include "kernels/errors.hpp"
+#include "kernels/filters/filter_list.hpp"
+#include "models/linear_model.hpp"
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+namespace kushner {
+
+/// Every filter name, in report order.
+inline std::vector<std::string> all_filter_names() {
+  std::vector<std::string> names;
+  for (const auto& f : filter_support<LinearModel<1>>()) names.push_back(f.name);  // names do not depend on the model
+  return names;
+}
+
+/// "all", or a comma-separated list of names (case-sensitive), checked against what Model supports.
+template <class Model>
+std::vector<std::string> select_filters(const std::string& list) {
+  const std::vector<FilterSupport> support = filter_support<Model>();
+  std::vector<std::string> requested;
+  if (list == "all") {
+    for (const auto& f : support)
+      if (f.unsupported == nullptr) requested.push_back(f.name);
+    return requested;
+  }
+  std::string current;
+  for (std::size_t i = 0; i <= list.size(); ++i) {
+    if (i == list.size() || list[i] == ',') {
+      KUSHNER_INPUT_REQUIRE(!current.empty(), "--filters: empty name in '" << list << "'");
+      requested.push_back(current);
+      current.clear();
+    } else if (list[i] != ' ') {
+      current += list[i];
+    }
+  }
+  for (const auto& name : requested) {
+    const auto it =
+        std::find_if(support.begin(), support.end(), [&](const FilterSupport& f) { return f.name == name; });
+    if (it == support.end()) {
+      std::string known;
+      for (const auto& f : support) known += (known.empty() ? "" : ", ") + f.name;
+      throw InputError("--filters: unknown filter '" + name + "' (known: " + known + ", or all)");
+    }
+    KUSHNER_INPUT_REQUIRE(it->unsupported == nullptr, "filter " << name << " does not support model '" << Model::name
+                                                                << "' (" << it->unsupported << ")");
+  }
+  std::vector<std::string> ordered;  // report order, each once
+  for (const auto& f : support)
+    if (std::find(requested.begin(), requested.end(), f.name) != requested.end()) ordered.push_back(f.name);
+  return ordered;
+}
+
+}  // namespace kushner

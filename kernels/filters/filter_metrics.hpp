@@ -1,0 +1,62 @@
+#pragma once
+// Per-member metric kernels behind the bank's reports: time averages of the accumulated errors (NaN for a
+// member that is not scored, so that ensemble_moments leaves it out and counts it) and status counts.
+// Integer counts are order-independent, so a parallel_reduce keeps them deterministic.
+#include "kernels/bank.hpp"
+#include "kernels/filters/filter_slot.hpp"
+#include "kernels/math.hpp"
+#include "kernels/status.hpp"
+
+#include <Kokkos_Core.hpp>
+
+namespace kushner {
+
+/// Columns of MemberScores::out.
+enum MemberScoreColumn : int {
+  member_mean_squared_error = 0,
+  member_mean_nees = 1,
+  member_mean_squared_reference_error = 2,
+  num_member_score_columns = 3
+};
+
+template <class MemSpace>
+struct MemberScores {
+  BankVector<MemSpace> score;  // (member, ScoreColumn)
+  BankScalar<Status, MemSpace> status, truth_status;
+  BankVector<MemSpace> out;  // (member, MemberScoreColumn)
+  double points;             // time points accumulated
+  bool has_reference;
+
+  KOKKOS_INLINE_FUNCTION void operator()(const int member) const {
+    const bool scored = status(member) == Status::ok && truth_status(member) == Status::ok;
+    const double nan = math::quiet_nan();
+    out(member, member_mean_squared_error) = scored ? score(member, squared_error_sum) / points : nan;
+    out(member, member_mean_nees) =
+        scored && score(member, nees_points) > 0 ? score(member, nees_sum) / score(member, nees_points) : nan;
+    out(member, member_mean_squared_reference_error) =
+        scored && has_reference ? score(member, reference_squared_error_sum) / points : nan;
+  }
+};
+
+/// Members with status `which` among those whose truth is ok (all members when truth_status is empty): a
+/// filter that fails because its truth escaped to infinity has not diverged, its member just left the run.
+template <class MemSpace>
+struct CountStatus {
+  BankScalar<Status, MemSpace> status, truth_status;
+  Status which;
+  KOKKOS_INLINE_FUNCTION void operator()(const int member, long& count) const {
+    const bool counted = truth_status.extent(0) == 0 || truth_status(member) == Status::ok;
+    count += counted && status(member) == which ? 1 : 0;
+  }
+};
+
+template <class ExecSpace, class MemSpace>
+long count_status(const ExecSpace& space, const BankScalar<Status, MemSpace>& status, Status which,
+                  const BankScalar<Status, MemSpace>& truth_status = {}) {
+  long count = 0;
+  Kokkos::parallel_reduce("kushner::count_status", Kokkos::RangePolicy<ExecSpace>(space, 0, status.extent(0)),
+                          CountStatus<MemSpace>{status, truth_status, which}, count);
+  return count;
+}
+
+}  // namespace kushner

@@ -1,0 +1,22 @@
+#pragma once
+// First-order (Taylor) linearizations at a point, shared by the EKF family, the second-order filters and KBL.
+#include "kernels/filters/filter_step.hpp"
+
+namespace kushner {
+
+/// h_hat = h(t, x), H = dh/dx(t, x).
+template <class Model>
+KOKKOS_INLINE_FUNCTION ObservationLinearization<Model::state_dim, Model::obs_dim> observation_linearization(
+    const Model& model, double t, const Vec<Model::state_dim>& x) {
+  return {model.observation(t, x), model.observation_jacobian(t, x)};
+}
+
+/// a = f(t, x), J = df/dx(t, x), W = G(t, x) G(t, x)^T.
+template <class Model>
+KOKKOS_INLINE_FUNCTION DriftLinearization<Model::state_dim> drift_linearization(const Model& model, double t,
+                                                                                const Vec<Model::state_dim>& x) {
+  const auto u = Model::Control::zero();
+  return {model.drift(t, x, u), model.drift_jacobian(t, x, u), noise_intensity(model.diffusion(t, x))};
+}
+
+}  // namespace kushner

@@ -1,0 +1,46 @@
+#pragma once
+// KBL: the Kalman-Bucy filter of the model linearized at the origin (seed 002 automotive (22), terpolymer
+// (20)-(21): "only the linear terms and innovations processes"):
+//   a0 = f(t, 0), F0 = df/dx(t, 0), c0 = h(t, 0), H0 = dh/dx(t, 0), W0 = G(t, 0) G(t, 0)^T,
+//   dm = (a0 + F0 m) dt + P H0^T V^{-1} (dy - (c0 + H0 m) dt),   dP = (F0 P + P F0^T + W0 - P H0^T V^{-1} H0 P) dt.
+#include "kernels/filters/filter_config.hpp"
+#include "kernels/filters/jacobian_linearization.hpp"
+
+namespace kushner {
+
+/// The linearization at the origin, evaluated at m: (a0 + F0 m, F0, W0) and (c0 + H0 m, H0).
+template <class Model>
+KOKKOS_INLINE_FUNCTION DriftLinearization<Model::state_dim> drift_linearization_at_origin(
+    const Model& model, double t, const Vec<Model::state_dim>& m) {
+  DriftLinearization<Model::state_dim> d = drift_linearization(model, t, Vec<Model::state_dim>::zero());
+  d.a += d.J * m;
+  return d;
+}
+template <class Model>
+KOKKOS_INLINE_FUNCTION ObservationLinearization<Model::state_dim, Model::obs_dim> observation_linearization_at_origin(
+    const Model& model, double t, const Vec<Model::state_dim>& m) {
+  ObservationLinearization<Model::state_dim, Model::obs_dim> o =
+      observation_linearization(model, t, Vec<Model::state_dim>::zero());
+  o.h += o.H * m;
+  return o;
+}
+
+template <class Model, class MemSpace>
+struct LinearizedKalmanBucyFilter {
+  static constexpr int n = Model::state_dim, p = Model::obs_dim;
+  static constexpr const char* name = "KBL";
+  static constexpr const char* description = "Kalman-Bucy on the model linearized at the origin";
+  static constexpr const char* unsupported = nullptr;
+
+  static LinearizedKalmanBucyFilter create(const FilterConfig&, const Model&, long) { return {}; }
+
+  KOKKOS_INLINE_FUNCTION Status step(const Model& model, int, const StepInput<p>& in, Vec<n>& m, Mat<n, n>& P) const {
+    Vec<p> weighted_innovation;
+    if (!kalman_update(observation_linearization_at_origin(model, in.t, m), in, m, P, weighted_innovation))
+      return Status::not_positive_definite;
+    euler_predict(drift_linearization_at_origin(model, in.t, m), in.dt, m, P);
+    return Status::ok;
+  }
+};
+
+}  // namespace kushner

@@ -1,0 +1,126 @@
+#pragma once
+// What a model offers the filters, detected at compile time, and the structured drift forms derived from the
+// most specific one a model has (a linear model is also a degree-1 polynomial and its own SDC factorization).
+// Filters read these to decide, at compile time, whether they support a model (kernels/filters/filter_list.hpp).
+#include "models/drift_forms.hpp"
+
+#include <type_traits>
+#include <utility>
+
+namespace kushner {
+
+namespace detail {
+template <class Model, class = void>
+struct has_linear_form : std::false_type {};
+template <class Model>
+struct has_linear_form<Model, std::void_t<decltype(std::declval<const Model&>().linear_form(0.0))>> : std::true_type {};
+
+template <class Model, class = void>
+struct has_power_polynomial : std::false_type {};
+template <class Model>
+struct has_power_polynomial<Model, std::void_t<decltype(std::declval<const Model&>().drift_power_polynomial(0.0))>>
+    : std::true_type {};
+
+template <class Model, class = void>
+struct has_quadratic_polynomial : std::false_type {};
+template <class Model>
+struct has_quadratic_polynomial<Model,
+                                std::void_t<decltype(std::declval<const Model&>().drift_quadratic_polynomial(0.0))>>
+    : std::true_type {};
+
+template <class Model, class = void>
+struct has_gaussian_drift : std::false_type {};
+template <class Model>
+struct has_gaussian_drift<Model, std::void_t<decltype(std::declval<const Model&>().gaussian_drift(
+                                     0.0, std::declval<const Vec<Model::state_dim>&>(),
+                                     std::declval<const Mat<Model::state_dim, Model::state_dim>&>()))>>
+    : std::true_type {};
+
+template <class Model, class = void>
+struct has_sdc_drift : std::false_type {};
+template <class Model>
+struct has_sdc_drift<Model, std::void_t<decltype(std::declval<const Model&>().sdc_drift(
+                                0.0, std::declval<const Vec<Model::state_dim>&>()))>> : std::true_type {};
+
+template <class Model, class = void>
+struct declares_linear_observation : std::false_type {};
+template <class Model>
+struct declares_linear_observation<Model, std::enable_if_t<Model::linear_observation>> : std::true_type {};
+
+template <class Model, class = void>
+struct declares_non_integrable_drift : std::false_type {};
+template <class Model>
+struct declares_non_integrable_drift<Model, std::enable_if_t<!Model::drift_gaussian_integrable>> : std::true_type {};
+}  // namespace detail
+
+/// Capabilities of a continuous-time model, as the filters see them.
+template <class Model>
+struct ModelTraits {
+  static constexpr bool linear = detail::has_linear_form<Model>::value;
+  /// h(t, x) = h(t, 0) + H x, H = observation_jacobian(t, .) constant in x.
+  static constexpr bool linear_observation = linear || detail::declares_linear_observation<Model>::value;
+  static constexpr bool power_polynomial = linear || detail::has_power_polynomial<Model>::value;
+  static constexpr bool quadratic_polynomial = linear || detail::has_quadratic_polynomial<Model>::value;
+  static constexpr bool polynomial = power_polynomial || quadratic_polynomial;
+  static constexpr bool sdc = linear || detail::has_sdc_drift<Model>::value;
+  /// E_N[f] exists for every Gaussian (false for tan: E|tan x| is infinite).
+  static constexpr bool gaussian_integrable = !detail::declares_non_integrable_drift<Model>::value;
+  /// E_N[f], E_N[grad f] in closed form: the model's own formulas, or exact Gaussian moments of a polynomial.
+  static constexpr bool closed_form_expectations =
+      gaussian_integrable && linear_observation && (detail::has_gaussian_drift<Model>::value || polynomial);
+
+  static constexpr int power_degree() {
+    if constexpr (detail::has_power_polynomial<Model>::value)
+      return decltype(std::declval<const Model&>().drift_power_polynomial(0.0))::degree;
+    else
+      return linear ? 1 : 0;
+  }
+};
+
+/// The drift as a componentwise power polynomial (degree 1 for a linear model).
+template <class Model>
+KOKKOS_INLINE_FUNCTION auto drift_power_polynomial(const Model& model, double t) {
+  constexpr int n = Model::state_dim;
+  if constexpr (detail::has_power_polynomial<Model>::value) {
+    return model.drift_power_polynomial(t);
+  } else {
+    static_assert(ModelTraits<Model>::linear,
+                  "drift_power_polynomial: Model has neither drift_power_polynomial(t) nor linear_form(t)");
+    const auto lf = model.linear_form(t);
+    auto poly = PowerPolynomial<n, 1>::zero();
+    poly.a0 = lf.a0;
+    poly.coefficient[1] = lf.A;
+    return poly;
+  }
+}
+
+/// The drift as a quadratic polynomial with bilinear terms (no terms for a linear model).
+template <class Model>
+KOKKOS_INLINE_FUNCTION auto drift_quadratic_polynomial(const Model& model, double t) {
+  if constexpr (detail::has_quadratic_polynomial<Model>::value) {
+    return model.drift_quadratic_polynomial(t);
+  } else {
+    static_assert(ModelTraits<Model>::linear,
+                  "drift_quadratic_polynomial: Model has neither drift_quadratic_polynomial(t) nor linear_form(t)");
+    const auto lf = model.linear_form(t);
+    QuadraticPolynomial<Model::state_dim, 0> poly;
+    poly.a0 = lf.a0;
+    poly.a1 = lf.A;
+    return poly;
+  }
+}
+
+/// f(t, x) = A(x) x + b (seed 001 (4), with the known input b of Theorem 3 (ii)).
+template <class Model>
+KOKKOS_INLINE_FUNCTION SdcDrift<Model::state_dim> drift_sdc(const Model& model, double t,
+                                                            const Vec<Model::state_dim>& x) {
+  if constexpr (detail::has_sdc_drift<Model>::value) {
+    return model.sdc_drift(t, x);
+  } else {
+    static_assert(ModelTraits<Model>::linear, "drift_sdc: Model has neither sdc_drift(t, x) nor linear_form(t)");
+    const auto lf = model.linear_form(t);
+    return {lf.A, lf.a0};
+  }
+}
+
+}  // namespace kushner

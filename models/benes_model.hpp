@@ -1,0 +1,53 @@
+#pragma once
+// Benes' model: dx = tanh(x) dt + dw, dy = x dt + r dv. Its conditional density is known in closed form
+// (Benes 1981; /work/notes/references.md section 1), so it validates filters and particle filters against
+// the exact answer; the unit diffusion is part of the Benes condition f' + f^2 = 1 (not a parameter).
+// Defaults (ours, as in the references' check (B)): r = 0.5, x(0) ~ N(0.5, 1) for truths and prior alike.
+#include "kernels/math.hpp"
+#include "kernels/small_matrix.hpp"
+#include "models/drift_forms.hpp"
+#include "models/initial_law.hpp"
+
+namespace kushner {
+
+struct BenesModel : InitialLaw<1> {
+  static constexpr int state_dim = 1, obs_dim = 1, noise_dim = 1, control_dim = 0;
+  static constexpr bool discrete_time = false;
+  static constexpr bool linear_observation = true;
+  static constexpr const char* name = "benes";
+  static constexpr const char* description = "Benes: dx = tanh(x) dt + dw, dy = x dt + r dv (exact filter known)";
+  using Control = Vec<control_dim>;
+
+  double r = 0.5;
+
+  BenesModel() { set_initial_law(Vec<1>{{0.5}}, Mat<1, 1>{{{1.0}}}); }
+
+  template <class Visitor>
+  void parameters(Visitor&& v) {
+    v("r", r, "observation noise intensity");
+    initial_law_parameters(v);
+  }
+
+  KOKKOS_INLINE_FUNCTION Vec<1> drift(double, const Vec<1>& x, const Control&) const { return {{math::tanh(x[0])}}; }
+  KOKKOS_INLINE_FUNCTION Mat<1, 1> drift_jacobian(double, const Vec<1>& x, const Control&) const {
+    const double th = math::tanh(x[0]);
+    return {{{1.0 - th * th}}};
+  }
+  KOKKOS_INLINE_FUNCTION Mat<1, 1> drift_hessian(double, const Vec<1>& x, const Control&, int) const {
+    const double th = math::tanh(x[0]);
+    return {{{-2.0 * th * (1.0 - th * th)}}};
+  }
+  KOKKOS_INLINE_FUNCTION Mat<1, 1> diffusion(double, const Vec<1>&) const { return {{{1.0}}}; }
+  KOKKOS_INLINE_FUNCTION Vec<1> observation(double, const Vec<1>& x) const { return x; }
+  KOKKOS_INLINE_FUNCTION Mat<1, 1> observation_jacobian(double, const Vec<1>&) const { return {{{1.0}}}; }
+  KOKKOS_INLINE_FUNCTION Mat<1, 1> observation_hessian(double, const Vec<1>&, int) const { return {{{0.0}}}; }
+  KOKKOS_INLINE_FUNCTION Mat<1, 1> observation_noise(double) const { return {{{r}}}; }
+
+  /// tanh x = A(x) x with A(x) = tanh(x) / x (1 at 0): the ASRE factorization.
+  KOKKOS_INLINE_FUNCTION SdcDrift<1> sdc_drift(double, const Vec<1>& x) const {
+    const double v = x[0];
+    return {{{{math::fabs(v) < 1e-4 ? 1.0 - v * v / 3.0 : math::tanh(v) / v}}}, {{0.0}}};
+  }
+};
+
+}  // namespace kushner

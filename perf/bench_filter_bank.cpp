@@ -1,0 +1,90 @@
+// The whole filter bank's step (truths + every filter the model supports, one fused kernel): member-steps per
+// second, next to the truth step alone in the same binary. ASRE runs a fixed 8 iterates per member (its
+// convergence passes are not part of a step; the seed models need 5-8 on average at tolerance 1e-6).
+#include "drivers/filter_bank.hpp"
+#include "drivers/filter_selection.hpp"
+#include "models/cubic_oscillator_model.hpp"
+#include "models/sine_model.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <string>
+
+namespace kushner {
+namespace {
+
+using Space = Kokkos::DefaultExecutionSpace;
+constexpr int asre_iterates = 8;
+
+template <class Model>
+void BM_FilterBankStep(benchmark::State& state) {
+  const long members = state.range(0);
+  const Space space;
+  const std::vector<std::string> filters = select_filters<Model>("all");
+  FilterConfig config;
+  config.asre_iterations.assign(members, asre_iterates);
+  FilterBank<Space, Model> bank(space, Model{}, Model{}, members, 42, filters, config);
+  long k = 0;
+  for (auto _ : state) {
+    space.fence();
+    Kokkos::Timer timer;
+    bank.step(k++, 1e-3, false);
+    space.fence();
+    state.SetIterationTime(timer.seconds());
+  }
+  using C = benchmark::Counter;
+  state.counters["member_steps_per_s"] = C(static_cast<double>(members), C::kIsIterationInvariantRate);
+  state.counters["filters"] = static_cast<double>(filters.size());
+  std::string label;
+  for (const auto& name : filters) {
+    label += (label.empty() ? "" : ",") + name;
+    if (bank.scores(name, k + 1).diverged > 0) state.SkipWithError(("diverged members in " + name).c_str());
+  }
+  state.SetLabel(label);
+}
+
+/// The baseline: the same truths stepped alone (what `kushner simulate` does per step).
+template <class Model>
+void BM_TruthStepAlone(benchmark::State& state) {
+  const long members = state.range(0);
+  const Space space;
+  TruthBank<Space, Model> bank(space, Model{}, members, 42);
+  long k = 0;
+  for (auto _ : state) {
+    space.fence();
+    Kokkos::Timer timer;
+    bank.step(k++, 1e-3);
+    space.fence();
+    state.SetIterationTime(timer.seconds());
+  }
+  using C = benchmark::Counter;
+  state.counters["member_steps_per_s"] = C(static_cast<double>(members), C::kIsIterationInvariantRate);
+}
+
+BENCHMARK_TEMPLATE(BM_FilterBankStep, SineModel)
+    ->ArgName("members")
+    ->Arg(10000)
+    ->Arg(100000)
+    ->Arg(1000000)
+    ->UseManualTime();
+BENCHMARK_TEMPLATE(BM_TruthStepAlone, SineModel)
+    ->ArgName("members")
+    ->Arg(10000)
+    ->Arg(100000)
+    ->Arg(1000000)
+    ->UseManualTime();
+BENCHMARK_TEMPLATE(BM_FilterBankStep, CubicOscillatorModel)
+    ->ArgName("members")
+    ->Arg(10000)
+    ->Arg(100000)
+    ->Arg(1000000)
+    ->UseManualTime();
+BENCHMARK_TEMPLATE(BM_TruthStepAlone, CubicOscillatorModel)
+    ->ArgName("members")
+    ->Arg(10000)
+    ->Arg(100000)
+    ->Arg(1000000)
+    ->UseManualTime();
+
+}  // namespace
+}  // namespace kushner

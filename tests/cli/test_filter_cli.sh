@@ -1,0 +1,79 @@
+#!/usr/bin/env bash
+# `kushner filter` and `kushner filters`: what a run writes, and the refusals (exit 2, one line on stderr, no
+# output directory created).
+set -euo pipefail
+kushner=$1
+source "$(dirname "$0")/lib.sh"
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+expect_refused() {  # expect_refused "exact message" args...
+  local expected=$1; shift
+  run_kushner "$work/r" "$@" --out "$work/refused"
+  [ "$rc" -eq 2 ] || fail "exit $rc (want 2) for: $*; stderr: $(cat "$work/r.err")"
+  [ "$(wc -l <"$work/r.err")" -eq 1 ] || fail "stderr is not one line for: $*: $(cat "$work/r.err")"
+  [ "$(cat "$work/r.err")" = "kushner: error: $expected" ] || fail "message for: $*: $(cat "$work/r.err") (want: $expected)"
+  [ ! -e "$work/refused" ] || fail "a refused run created its output directory: $*"
+  echo "ok: $expected"
+}
+
+expect_refused "filter POLY3 does not support model 'car' (drift is not polynomial)" filter --model car --filters POLY3
+expect_refused "filter KB does not support model 'sine' (model is not linear)" filter --model sine --filters EKF,KB
+expect_refused "filter QLF does not support model 'car' (the drift has no Gaussian expectation)" filter --model car --filters QLF
+expect_refused "filter BILIN does not support model 'cubic-oscillator' (drift is not bilinear)" \
+  filter --model cubic-oscillator --filters BILIN
+expect_refused "--filters: unknown filter 'UKF' (known: KB, EKF, EKF-DS, SOF, SOF-B, QLF, POLY3, POLY4, BILIN, MIXED, ASRE, KBL, or all)" \
+  filter --model sine --filters EKF,UKF
+expect_refused "--filters: empty name in 'EKF,,SOF'" filter --model sine --filters EKF,,SOF
+expect_refused "--model: 'clark-linear' is a discrete-time model; \`kushner filter\` runs the continuous-time filters" \
+  filter --model clark-linear
+expect_refused "--qlf-expectations: model 'benes' has no closed-form Gaussian expectations (use cubature)" \
+  filter --model benes --filters QLF --qlf-expectations closed
+expect_refused "--qlf-expectations: cubature is limited to state_dim <= 3 (model 'terpolymer' has 10)" \
+  filter --model terpolymer --filters QLF --qlf-expectations cubature
+expect_refused "--gh-nodes: must be in 1 .. 40 (got 0)" filter --model sine --gh-nodes 0
+expect_refused "--asre-tolerance: must be positive (got -1)" filter --model sine --asre-tolerance -1
+expect_refused "--dt: must be positive (got 0)" filter --model sine --dt 0
+
+# A run: summary.json with the metrics and the run's metadata, timeseries.csv per time and filter.
+"$kushner" filter --model cubic-oscillator --filters QLF,POLY3,ASRE,EKF --members 200 --T 0.5 --dt 1e-2 --seed 3 \
+  --output-points 5 --out "$work/run" --quiet
+python3 - "$work/run" <<'PY' || fail "summary.json or timeseries.csv is not what a run must write"
+import csv, json, math, sys
+run = sys.argv[1]
+s = json.load(open(run + "/summary.json"))
+for key in ("command", "seed", "version", "git", "backend", "model", "members", "T", "dt", "steps", "filters"):
+    assert key in s, key
+assert s["seed"] == 3 and s["members"] == 200 and s["steps"] == 50
+assert s["filter_order"] == ["EKF", "QLF", "POLY3", "ASRE"], s["filter_order"]
+for name, f in s["filters"].items():
+    for key in ("rmse_truth", "rmse_truth_se", "nees", "nees_se", "diverged"):
+        assert key in f, (name, key)
+    assert 0 < f["rmse_truth"] < 10 and 0 < f["rmse_truth_se"] < f["rmse_truth"], (name, f)
+assert s["filters"]["QLF"]["expectations"] == "closed"
+assert abs(s["filters"]["QLF"]["rmse_truth"] - s["filters"]["POLY3"]["rmse_truth"]) < 1e-9
+it = s["filters"]["ASRE"]["iterations"]
+assert 1 <= it["min"] <= it["mean"] <= it["max"] <= it["max_iterations"], it
+lines = open(run + "/timeseries.csv").read().splitlines()
+assert lines[0].startswith("# kushner ") and "seed 3" in lines[0]
+rows = list(csv.DictReader(lines[1:]))
+assert list(rows[0].keys()) == ["t", "filter", "rmse_truth", "rmse_truth_se", "nees", "nees_se", "diverged"], rows[0].keys()
+assert len(rows) == 6 * 4, len(rows)
+assert [r["filter"] for r in rows[:4]] == ["EKF", "QLF", "POLY3", "ASRE"]
+assert float(rows[0]["t"]) == 0 and float(rows[-1]["t"]) == 0.5
+assert all(math.isfinite(float(r["rmse_truth"])) for r in rows)
+PY
+echo "ok: summary.json and timeseries.csv"
+
+# `kushner filters`: every filter and the models it supports, as text and JSON.
+"$kushner" filters >"$work/list.txt"
+grep -q '^POLY3 ' "$work/list.txt" || fail "no POLY3 in kushner filters"
+grep -q '^    not car: drift is not polynomial$' "$work/list.txt" || fail "kushner filters does not say why POLY3 refuses car"
+"$kushner" filters --json | python3 -c '
+import json, sys
+filters = {f["name"]: f for f in json.load(sys.stdin)}
+assert list(filters) == ["KB", "EKF", "EKF-DS", "SOF", "SOF-B", "QLF", "POLY3", "POLY4", "BILIN", "MIXED", "ASRE", "KBL"]
+assert filters["KB"]["models"] == ["linear", "ou"], filters["KB"]["models"]
+assert "terpolymer" in filters["BILIN"]["models"] and "sine" not in filters["POLY3"]["models"]
+' || fail "kushner filters --json"
+echo "ok: kushner filters"

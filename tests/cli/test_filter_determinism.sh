@@ -1,0 +1,62 @@
+#!/usr/bin/env bash
+# `kushner filter`: same seed, same numbers. timeseries.csv byte-identical on 1 and 2 OpenMP threads and on the
+# Serial backend; summary.json identical apart from the "backend" field; on a GPU, equal to a stated tolerance.
+set -euo pipefail
+kushner=$1
+source "$(dirname "$0")/lib.sh"
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+run_as() {  # run_as NAME ENV... -- ARGS...: run into $work/out (the same --out each time: it is in the files)
+  local name=$1; shift
+  local envs=()
+  while [ "$1" != "--" ]; do envs+=("$1"); shift; done
+  shift
+  (cd "$work" && env "${envs[@]}" "$kushner" filter "$@" --out out --quiet)
+  mv "$work/out" "$work/$name"
+}
+compare_runs() {
+  local name=$1; shift
+  local backends
+  backends=$("$kushner" --version | sed -n 's/^available backends: \(.*\) (select.*/\1/p')
+  run_as "$name-serial" KUSHNER_BACKEND=serial -- "$@"
+  if grep -qw openmp <<<"$backends"; then
+    run_as "$name-omp1" OMP_NUM_THREADS=1 KUSHNER_BACKEND=openmp -- "$@"
+    run_as "$name-omp2" OMP_NUM_THREADS=2 KUSHNER_BACKEND=openmp -- "$@"
+    for other in omp1 omp2; do
+      cmp "$work/$name-serial/timeseries.csv" "$work/$name-$other/timeseries.csv" ||
+        fail "$name: timeseries.csv differs between serial and $other"
+      python3 - "$work/$name-serial/summary.json" "$work/$name-$other/summary.json" <<'PY' || fail "$name: summary.json differs (serial vs $other)"
+import json, sys
+a, b = (json.load(open(p)) for p in sys.argv[1:3])
+a.pop("backend"), b.pop("backend")
+if a != b:
+    sys.exit("summaries differ beyond the backend: %s" % sorted(k for k in a if a[k] != b.get(k)))
+PY
+    done
+    echo "ok: $name identical on serial, omp1, omp2"
+  fi
+  if grep -qw cuda <<<"$backends"; then
+    run_as "$name-cuda" KUSHNER_BACKEND=cuda -- "$@"
+    # FMA contraction and CUDA's libm round differently from glibc: equal to a stated relative tolerance.
+    python3 - "$work/$name-serial/timeseries.csv" "$work/$name-cuda/timeseries.csv" <<'PY' || fail "$name: cuda differs from serial"
+import math, sys
+rows = [[l.rstrip("\n").split(",") for l in open(p) if not l.startswith("#")] for p in sys.argv[1:3]]
+assert rows[0][0] == rows[1][0], "headers differ"
+worst = 0.0
+for ra, rb in zip(rows[0][1:], rows[1][1:]):
+    assert ra[:2] == rb[:2], "rows differ in time or filter: %s %s" % (ra[:2], rb[:2])
+    for a, b in zip(map(float, ra[2:]), map(float, rb[2:])):
+        if math.isnan(a) and math.isnan(b):
+            continue
+        worst = max(worst, abs(a - b) / max(abs(a), abs(b), 1e-300))
+print("largest relative difference cuda vs serial: %.3g" % worst)
+sys.exit(worst > 1e-8)
+PY
+  fi
+}
+
+compare_runs sine --model sine --filters all --members 2000 --T 1 --dt 1e-2 --seed 7 --output-points 20
+compare_runs cubic --model cubic-oscillator --filters all --members 1001 --T 0.5 --dt 5e-3 --seed 8 --output-points 10
+compare_runs car --model car --filters all --members 500 --T 0.5 --dt 5e-3 --seed 9 --output-points 10
+compare_runs terpolymer --model terpolymer --filters BILIN,MIXED,KBL,EKF --members 300 --T 0.2 --dt 1e-2 --seed 10

@@ -1,0 +1,27 @@
+#pragma once
+// Helpers shared by the filter tests: comparing the estimates of two filters member by member.
+#include <Kokkos_Core.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+namespace kushner::test {
+
+/// max over members (rows) of |a - b|_inf / |b|_inf, for two (member, k) views.
+template <class ViewA, class ViewB>
+double largest_relative_difference(const ViewA& a, const ViewB& b) {
+  const auto ha = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), a);
+  const auto hb = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), b);
+  double worst = 0.0;
+  for (std::size_t member = 0; member < ha.extent(0); ++member) {
+    double diff = 0.0, scale = 0.0;
+    for (std::size_t k = 0; k < ha.extent(1); ++k) {
+      diff = std::max(diff, std::abs(ha(member, k) - hb(member, k)));
+      scale = std::max(scale, std::abs(hb(member, k)));
+    }
+    worst = std::max(worst, diff / scale);
+  }
+  return worst;
+}
+
+}  // namespace kushner::test

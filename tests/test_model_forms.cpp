@@ -1,0 +1,100 @@
+// The structured forms each model hands the filters describe the same drift as drift() itself: linear
+// forms, componentwise and bilinear polynomials, SDC factorizations A(x) x + b, linear observations, and the
+// closed-form Gaussian expectations (seed 000 (6.4)-(6.5), (6.14); polynomial moments) against 20-node
+// Gauss-Hermite cubature. Every continuous-time model of the registry is checked for every form it has.
+#include "kernels/filters/gaussian_expectations.hpp"
+#include "models/registry.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace kushner {
+namespace {
+
+template <int N>
+void expect_vectors_near(const Vec<N>& a, const Vec<N>& b, double tolerance, const std::string& what) {
+  for (int i = 0; i < N; ++i) EXPECT_NEAR(a[i], b[i], tolerance * (1 + std::abs(b[i]))) << what << " [" << i << "]";
+}
+
+template <class Model>
+Vec<Model::state_dim> test_point(int k) {
+  Vec<Model::state_dim> x;
+  for (int i = 0; i < Model::state_dim; ++i) x[i] = 0.6 * std::sin(1.3 * k + 0.7 * i) + 0.1 * i;
+  return x;
+}
+
+/// A positive definite covariance with correlations, scaled by s.
+template <int N>
+Mat<N, N> test_covariance(double s) {
+  Mat<N, N> P = Mat<N, N>::zero();
+  for (int i = 0; i < N; ++i)
+    for (int j = 0; j < N; ++j) P(i, j) = s * (i == j ? 1.0 : 0.3 / (1 + std::abs(i - j)));
+  return P;
+}
+
+template <class Model>
+void expect_forms_match_drift(const Model& model) {
+  constexpr int n = Model::state_dim;
+  using T = ModelTraits<Model>;
+  const typename Model::Control u = Model::Control::zero();
+  const double t = 0.4;
+  const std::string name = Model::name;
+  for (int k = 0; k < 5; ++k) {
+    const Vec<n> x = test_point<Model>(k);
+    const Vec<n> f = model.drift(t, x, u);
+    if constexpr (T::power_polynomial)
+      expect_vectors_near(drift_power_polynomial(model, t)(x), f, 1e-13, name + " power polynomial");
+    if constexpr (T::quadratic_polynomial)
+      expect_vectors_near(drift_quadratic_polynomial(model, t)(x), f, 1e-13, name + " quadratic polynomial");
+    if constexpr (T::sdc) {
+      const SdcDrift<n> s = drift_sdc(model, t, x);
+      expect_vectors_near(s.A * x + s.b, f, 1e-13, name + " A(x) x + b");
+    }
+    if constexpr (T::linear) {
+      const auto lf = model.linear_form(t);
+      expect_vectors_near(lf.a0 + lf.A * x, f, 1e-13, name + " linear form drift");
+      expect_vectors_near(lf.c0 + lf.C * x, model.observation(t, x), 1e-13, name + " linear form observation");
+    }
+    if constexpr (T::linear_observation) {
+      const auto h0 = model.observation(t, Vec<n>::zero());
+      expect_vectors_near(h0 + model.observation_jacobian(t, x) * x, model.observation(t, x), 1e-13,
+                          name + " linear observation");
+    }
+    if constexpr (T::closed_form_expectations && n <= max_cubature_dim) {
+      const GaussHermiteRule rule = make_gauss_hermite_rule(20);
+      for (double s : {0.01, 0.5}) {
+        const Mat<n, n> P = test_covariance<n>(s);
+        GaussianDrift<n> cubature;
+        ASSERT_TRUE(cubature_drift(model, t, x, P, rule, cubature));
+        const GaussianDrift<n> closed = closed_form_drift(model, t, x, P);
+        expect_vectors_near(closed.mean, cubature.mean, 1e-11, name + " E[f]");
+        for (int i = 0; i < n; ++i)
+          for (int j = 0; j < n; ++j)
+            EXPECT_NEAR(closed.jacobian(i, j), cubature.jacobian(i, j), 1e-11 * (1 + std::abs(cubature.jacobian(i, j))))
+                << name << " E[grad f] (" << i << ", " << j << ")";
+      }
+    }
+  }
+}
+
+TEST(ModelForms, EveryFormAModelHasDescribesItsDrift) {
+  int checked = 0;
+  detail::for_each_model_type([&](auto* tag) {
+    using Model = std::remove_pointer_t<decltype(tag)>;
+    if constexpr (!Model::discrete_time) {
+      expect_forms_match_drift(Model{});
+      ++checked;
+    }
+  });
+  EXPECT_EQ(checked, 10);
+}
+
+TEST(ModelForms, ClosedFormExpectationsDifferFromThePointValues) {  // power: E_N[f] != f(m) for nonlinear f
+  const SineModel sine;
+  const GaussianDrift<1> g = closed_form_drift(sine, 0.0, Vec<1>{{1.0}}, Mat<1, 1>{{{0.5}}});
+  EXPECT_GT(std::abs(g.mean[0] - sine.drift(0.0, Vec<1>{{1.0}}, SineModel::Control::zero())[0]), 0.1);
+}
+
+}  // namespace
+}  // namespace kushner
