@@ -73,8 +73,8 @@ class ParticleFilterBank {
                           "--ess-threshold: must be in [0, 1] (got " << options.ess_threshold << ")");
     use_team_ = options.kernel == ParticleKernel::team ||
                 (options.kernel == ParticleKernel::automatic && !std::is_same<MemSpace, Kokkos::HostSpace>::value);
-    KUSHNER_REQUIRE(use_team_ || std::is_same<MemSpace, Kokkos::HostSpace>::value,
-                    "the host block kernel needs host memory");
+    constexpr bool host_memory = std::is_same<MemSpace, Kokkos::HostSpace>::value;
+    KUSHNER_REQUIRE(use_team_ || host_memory, "the host block kernel needs host memory");
     block_size_ = use_team_ ? device_particle_chunk : host_particle_block;
     num_blocks_ = (num_particles + block_size_ - 1) / block_size_;
     team_size_ = options.team_size > 0 ? options.team_size : (std::is_same<MemSpace, Kokkos::HostSpace>::value ? 1 : device_particle_team);

@@ -110,7 +110,8 @@ KOKKOS_INLINE_FUNCTION double update_particle(const ParticleStepData<Model, MemS
   const double increment = dot(h, vinv_dy) - 0.5 * d.dt * dot(h, d.observation_precision * h);
   const double l = log_weight - log_normalizer + increment;
   bool finite = math::is_finite(l);
-  for (int i = 0; i < n; ++i) finite = finite && math::is_finite(x[i]);
+  KUSHNER_UNROLL_FULLY
+  for (int i = 0; i < n; ++i) finite = finite & math::is_finite(x[i]);  // `&`: no branch, so GCC can vectorize
   return finite ? l : -positive_infinity();
   }
 }
@@ -136,8 +137,10 @@ void particle_block_host(const ParticleStepData<Model, Kokkos::HostSpace>& d, in
 #pragma omp simd
   for (int j = 0; j < count; ++j) {
     Vec<n> xj;
+    KUSHNER_UNROLL_FULLY
     for (int i = 0; i < n; ++i) xj[i] = xs[i][j];
     const double lj = update_particle<SimdDraws, Initialize>(d, member, begin + j, lw[j], log_normalizer, vinv_dy, xj);
+    KUSHNER_UNROLL_FULLY
     for (int i = 0; i < n; ++i) xs[i][j] = xj[i];
     lw[j] = lj;
     l[j] = lj;
@@ -153,6 +156,7 @@ void particle_block_host(const ParticleStepData<Model, Kokkos::HostSpace>& d, in
 #pragma omp simd
     for (int j = 0; j < count; ++j) {
       e[j] = math::exp(l[j] - m);
+      KUSHNER_UNROLL_FULLY
       for (int i = 0; i < n; ++i) dx[i][j] = e[j] > 0.0 ? xs[i][j] - ref[i] : 0.0;
     }
     double s = 0.0, s2 = 0.0;

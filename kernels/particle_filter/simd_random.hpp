@@ -11,12 +11,20 @@
 #include <cstdint>
 #include <cstring>
 
+// GCC vectorizes a loop only if every loop inside it has been unrolled away: say so for the Philox rounds.
+#if defined(__GNUC__) && !defined(__clang__) && !defined(__CUDACC__)
+#define KUSHNER_UNROLL_FULLY _Pragma("GCC unroll 16")
+#else
+#define KUSHNER_UNROLL_FULLY
+#endif
+
 namespace kushner::simd {
 
 /// Philox4x32 with 10 rounds (Salmon et al. 2011, SC'11; constants from Random123's philox.h).
 KOKKOS_INLINE_FUNCTION void philox4x32_10(std::uint64_t c0, std::uint64_t c1, std::uint64_t c2, std::uint64_t c3,
                                           std::uint64_t k0, std::uint64_t k1, std::uint64_t out[4]) {
   constexpr std::uint64_t mask = 0xffffffffull;
+  KUSHNER_UNROLL_FULLY
   for (int round = 0; round < 10; ++round) {
     const std::uint64_t p0 = 0xD2511F53ull * c0, p1 = 0xCD9E8D57ull * c2;
     const std::uint64_t n0 = (p1 >> 32) ^ c1 ^ k0, n2 = (p0 >> 32) ^ c3 ^ k1;
@@ -54,9 +62,10 @@ template <int N>
 KOKKOS_INLINE_FUNCTION Vec<N> normal_vector(const RngKey& key, std::uint32_t member, std::uint32_t particle,
                                             std::uint32_t step) {
   Vec<N> z;
+  KUSHNER_UNROLL_FULLY
   for (int i = 0; i < N; i += 2) {
     double u0, u1;
-    uniform_pair(key, Counter{member, particle, step, static_cast<std::uint32_t>(i / 2)}, u0, u1);
+    simd::uniform_pair(key, Counter{member, particle, step, static_cast<std::uint32_t>(i / 2)}, u0, u1);
     const double radius = math::sqrt(-2.0 * math::log(u0));
     const double angle = 2.0 * math::pi * u1;
     z[i] = radius * math::cos(angle);
