@@ -65,6 +65,7 @@ TEST_P(ParticleKernels, FirstStepMatchesHandComputation) {
     EXPECT_NEAR(cov(m, 0), swxx / sw - mu * mu, 1e-12);
     EXPECT_NEAR(ess(m), sw * sw / sww, 1e-9 * particles);
     EXPECT_NEAR(pf.log_normalizer()(m), std::log(sw), 1e-12);
+    EXPECT_DOUBLE_EQ(pf.monte_carlo_standard_error()(m, 0), std::sqrt(cov(m, 0) / ess(m)));
   }
 }
 

@@ -130,6 +130,15 @@ class ParticleFilterBank {
   const BankScalar<double, MemSpace>& effective_sample_size() const { return ess_; }
   /// (member): resamplings so far.
   const BankScalar<int, MemSpace>& resample_count() const { return resample_count_; }
+  /// (member, i): sqrt(P_ii / ESS), the Monte Carlo standard error of the posterior mean as if the ESS
+  /// particles were independent draws from the posterior (Kong, Liu & Wong 1994). It ignores the variance
+  /// that earlier resamplings added, so it understates the error; independent seeds give the honest figure.
+  BankVector<MemSpace> monte_carlo_standard_error() const {
+    BankVector<MemSpace> se("kushner::particle_mc_se", num_members_, state_dim);
+    Kokkos::parallel_for("kushner::particle_mc_se", Kokkos::RangePolicy<ExecSpace>(space_, 0, num_members_),
+                         MonteCarloStandardError<state_dim, MemSpace>{covariance_, ess_, se});
+    return se;
+  }
   /// (member): ok, or non_finite once every particle of the member has left the finite numbers.
   const BankScalar<Status, MemSpace>& status() const { return status_; }
   /// (particle, member, i) and (particle, member): the particles and their log-weights; the normalized weight

@@ -22,6 +22,16 @@
 
 #include <cstdint>
 
+// `#pragma omp simd` where GCC honours it (-fopenmp or -fopenmp-simd); nothing elsewhere (nvcc's host pass).
+#define KUSHNER_PRAGMA(x) _Pragma(#x)
+#if defined(_OPENMP) || defined(KUSHNER_VECTOR_MATH)
+#define KUSHNER_SIMD KUSHNER_PRAGMA(omp simd)
+#define KUSHNER_SIMD_REDUCTION(...) KUSHNER_PRAGMA(omp simd reduction(__VA_ARGS__))
+#else
+#define KUSHNER_SIMD
+#define KUSHNER_SIMD_REDUCTION(...)
+#endif
+
 namespace kushner {
 
 /// Particles per block of the host kernel: its arrays stay in L1, and the blocks of all members are the
@@ -134,7 +144,7 @@ void particle_block_host(const ParticleStepData<Model, Kokkos::HostSpace>& d, in
   const Vec<Model::obs_dim> vinv_dy = d.initialize ? Vec<Model::obs_dim>::zero() : precision_times_dy(d, member);
   double l[B], e[B], dx[n][B];
 
-#pragma omp simd
+KUSHNER_SIMD
   for (int j = 0; j < count; ++j) {
     Vec<n> xj;
     KUSHNER_UNROLL_FULLY
@@ -146,21 +156,21 @@ void particle_block_host(const ParticleStepData<Model, Kokkos::HostSpace>& d, in
     l[j] = lj;
   }
   double m = -positive_infinity();
-#pragma omp simd reduction(max : m)
+KUSHNER_SIMD_REDUCTION(max : m)
   for (int j = 0; j < count; ++j) m = l[j] > m ? l[j] : m;
 
   WeightedMoments<n> w = WeightedMoments<n>::empty();
   if (m > -positive_infinity()) {
     const Vec<n> ref = load<n>(d.reference, member);
     w.max_log_weight = m;
-#pragma omp simd
+KUSHNER_SIMD
     for (int j = 0; j < count; ++j) {
       e[j] = math::exp(l[j] - m);
       KUSHNER_UNROLL_FULLY
       for (int i = 0; i < n; ++i) dx[i][j] = e[j] > 0.0 ? xs[i][j] - ref[i] : 0.0;
     }
     double s = 0.0, s2 = 0.0;
-#pragma omp simd reduction(+ : s, s2)
+KUSHNER_SIMD_REDUCTION(+ : s, s2)
     for (int j = 0; j < count; ++j) {
       s += e[j];
       s2 += e[j] * e[j];
@@ -169,12 +179,12 @@ void particle_block_host(const ParticleStepData<Model, Kokkos::HostSpace>& d, in
     w.sum_weight_sq = s2;
     for (int i = 0; i < n; ++i) {
       double sx = 0.0;
-#pragma omp simd reduction(+ : sx)
+KUSHNER_SIMD_REDUCTION(+ : sx)
       for (int j = 0; j < count; ++j) sx += e[j] * dx[i][j];
       w.sum_dx[i] = sx;
       for (int k = i; k < n; ++k) {
         double sxx = 0.0;
-#pragma omp simd reduction(+ : sxx)
+KUSHNER_SIMD_REDUCTION(+ : sxx)
         for (int j = 0; j < count; ++j) sxx += e[j] * dx[i][j] * dx[k][j];
         w.sum_dxdx[packed_index(n, i, k)] = sxx;
       }

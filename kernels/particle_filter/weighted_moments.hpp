@@ -16,20 +16,21 @@ KOKKOS_INLINE_FUNCTION constexpr double positive_infinity() { return Kokkos::Exp
 
 template <int N>
 struct WeightedMoments {
-  static constexpr int size = 3 + N + packed_size(N);  // doubles in a stored partial
+  static constexpr int packed = packed_size(N);       // entries of a packed N x N symmetric matrix
+  static constexpr int size = 3 + N + packed;         // doubles in a stored partial
 
   double max_log_weight;  // m; -inf for an empty set (or one whose weights are all zero)
   double sum_weight;      // sum e^{l - m}
   double sum_weight_sq;   // sum e^{2 (l - m)}
   Vec<N> sum_dx;          // sum e^{l - m} (x - ref)
-  Vec<packed_size(N)> sum_dxdx;  // sum e^{l - m} (x - ref)(x - ref)^T, packed upper triangle
+  Vec<packed> sum_dxdx;  // sum e^{l - m} (x - ref)(x - ref)^T, packed upper triangle
 
   KOKKOS_INLINE_FUNCTION static WeightedMoments empty() {
     WeightedMoments w;
     w.max_log_weight = -positive_infinity();
     w.sum_weight = w.sum_weight_sq = 0.0;
     w.sum_dx = Vec<N>::zero();
-    w.sum_dxdx = Vec<packed_size(N)>::zero();
+    w.sum_dxdx = Vec<packed>::zero();
     return w;
   }
 
@@ -62,7 +63,7 @@ struct WeightedMoments {
     out[1] = sum_weight;
     out[2] = sum_weight_sq;
     for (int i = 0; i < N; ++i) out[3 + i] = sum_dx[i];
-    for (int k = 0; k < packed_size(N); ++k) out[3 + N + k] = sum_dxdx[k];
+    for (int k = 0; k < packed; ++k) out[3 + N + k] = sum_dxdx[k];
   }
   KOKKOS_INLINE_FUNCTION static WeightedMoments load(const double* in) {
     WeightedMoments w;
@@ -70,7 +71,7 @@ struct WeightedMoments {
     w.sum_weight = in[1];
     w.sum_weight_sq = in[2];
     for (int i = 0; i < N; ++i) w.sum_dx[i] = in[3 + i];
-    for (int k = 0; k < packed_size(N); ++k) w.sum_dxdx[k] = in[3 + N + k];
+    for (int k = 0; k < packed; ++k) w.sum_dxdx[k] = in[3 + N + k];
     return w;
   }
   template <class View>
@@ -79,7 +80,7 @@ struct WeightedMoments {
     partials(block, member, 1) = sum_weight;
     partials(block, member, 2) = sum_weight_sq;
     for (int i = 0; i < N; ++i) partials(block, member, 3 + i) = sum_dx[i];
-    for (int k = 0; k < packed_size(N); ++k) partials(block, member, 3 + N + k) = sum_dxdx[k];
+    for (int k = 0; k < packed; ++k) partials(block, member, 3 + N + k) = sum_dxdx[k];
   }
   template <class View>
   KOKKOS_INLINE_FUNCTION static WeightedMoments load(const View& partials, int block, int member) {
@@ -88,7 +89,7 @@ struct WeightedMoments {
     w.sum_weight = partials(block, member, 1);
     w.sum_weight_sq = partials(block, member, 2);
     for (int i = 0; i < N; ++i) w.sum_dx[i] = partials(block, member, 3 + i);
-    for (int k = 0; k < packed_size(N); ++k) w.sum_dxdx[k] = partials(block, member, 3 + N + k);
+    for (int k = 0; k < packed; ++k) w.sum_dxdx[k] = partials(block, member, 3 + N + k);
     return w;
   }
 
@@ -105,13 +106,13 @@ struct WeightedMoments {
     sum_weight *= f;
     sum_weight_sq *= f * f;
     for (int i = 0; i < N; ++i) sum_dx[i] *= f;
-    for (int k = 0; k < packed_size(N); ++k) sum_dxdx[k] *= f;
+    for (int k = 0; k < packed; ++k) sum_dxdx[k] *= f;
   }
   KOKKOS_INLINE_FUNCTION void add_scaled(const WeightedMoments& o, double f) {
     sum_weight += f * o.sum_weight;
     sum_weight_sq += f * f * o.sum_weight_sq;
     for (int i = 0; i < N; ++i) sum_dx[i] += f * o.sum_dx[i];
-    for (int k = 0; k < packed_size(N); ++k) sum_dxdx[k] += f * o.sum_dxdx[k];
+    for (int k = 0; k < packed; ++k) sum_dxdx[k] += f * o.sum_dxdx[k];
   }
 };
 
