@@ -35,25 +35,37 @@ def med(rows, key):
     return (statistics.median(values), min(values), max(values), len(values)) if values else None
 
 
-def main():
-    out = sys.argv[1]
-    gpu = open(os.path.join(out, "gpu.csv")).read().strip().splitlines()[-1] if os.path.exists(os.path.join(out, "gpu.csv")) else "?"
-    print(f"device: {gpu}")
-    pf = load(os.path.join(out, "bench_particle_filter.json"))
+def report_sizes(out, source):
+    """Prints every PF step size in one benchmark file; returns the rate at M = 1000, N = 65536."""
+    pf = load(os.path.join(out, source))
     steps = iterations(pf, "BM_ParticleFilterStep")
     copies = iterations(pf, "BM_StreamCopy")
     target = None
+    if steps:
+        print(f"-- {source} ({pf['context'].get('backend', '?')})")
     for name, rows in steps.items():
         size = name.split("/", 1)[1]
         rate, lo, hi, n = med(rows, "particle_steps_per_s")
         gbs = med(rows, "GB_per_s")[0]
         copy = copies.get("BM_StreamCopy<SineModel>/" + size)
-        frac = f", {gbs / med(copy, 'GB_per_s')[0]:.2f} of BM_StreamCopy ({med(copy, 'GB_per_s')[0]:.0f} GB/s)" if copy else ""
+        frac = ""
+        if copy:
+            bw = med(copy, "GB_per_s")[0]
+            frac = f", {gbs / bw:.2f} of BM_StreamCopy ({bw:.0f} GB/s, floor {bw / 32e-9:.3g} particle-steps/s)"
         res = med(rows, "resamples_per_member_step")
         print(f"PF step {size}: median {rate:.3g} particle-steps/s (n={n}, spread {lo:.3g}..{hi:.3g}); "
               f"32 B/particle-step = {gbs:.0f} GB/s{frac}; resamples/member-step {res[0]:.2g}")
         if size == "members:1000/particles:65536":
             target = rate
+    return target
+
+
+def main():
+    out = sys.argv[1]
+    gpu_csv = os.path.join(out, "gpu.csv")
+    print("device: " + (open(gpu_csv).read().strip().splitlines()[-1] if os.path.exists(gpu_csv) else "?"))
+    target = report_sizes(out, "bench_compare.json")
+    print("-- PyTorch, same call as bench_compare.json")
     for mode in ("eager", "compile"):
         t = load(os.path.join(out, f"torch_{mode}.json"))
         if t and target:
@@ -62,17 +74,16 @@ def main():
         else:
             print(f"PyTorch {mode}: no result (see torch_{mode}.log)")
     if target:
-        print(f"target: >= 6e10 particle-steps/s: {'met' if target >= 6e10 else 'NOT met'} ({target:.3g})")
+        print(f"target >= 6e10 particle-steps/s at M=1000, N=65536: {'met' if target >= 6e10 else 'NOT met'} ({target:.3g})")
+    report_sizes(out, "bench_particle_filter.json")
     rs = load(os.path.join(out, "bench_resampling.json"))
     for name, rows in iterations(rs, "BM_Resample").items():
         m = med(rows, "particles_per_s")
         print(f"{name}: median {m[0]:.3g} particles/s (spread {m[1]:.3g}..{m[2]:.3g})")
-    for t in ("test_resampling", "test_particle_filter", "test_particle_filter_references", "test_grid_filter"):
+    for t in ("test_resampling", "test_particle_filter", "test_particle_filter_references", "test_grid_filter",
+              "test_particle_snapshot"):
         r = load(os.path.join(out, f"{t}.json"))
-        if r:
-            print(f"{t}: {r['tests'] - r['failures']}/{r['tests']} passed")
-        else:
-            print(f"{t}: no result")
+        print(f"{t}: {r['tests'] - r['failures']}/{r['tests']} passed" if r else f"{t}: no result")
 
 
 if __name__ == "__main__":

@@ -65,8 +65,10 @@ def main():
     p.add_argument("--repetitions", type=int, default=10)
     p.add_argument("--mode", choices=["eager", "compile"], default="eager")
     p.add_argument("--seed", type=int, default=42)
+    p.add_argument("--device", default="cuda", help="cuda (the benchmark), or cpu to check the script")
     a = p.parse_args()
-    device = torch.device("cuda")
+    device = torch.device(a.device)
+    sync = torch.cuda.synchronize if device.type == "cuda" else (lambda: None)
     gen = torch.Generator(device=device)
     gen.manual_seed(a.seed)
     step_fn = torch.compile(propagate_and_weigh) if a.mode == "compile" else propagate_and_weigh
@@ -89,20 +91,20 @@ def main():
     for _ in range(a.warmup):
         step(k)
         k += 1
-    torch.cuda.synchronize()
+    sync()
     rates = []
     for _ in range(a.repetitions):
         start = time.perf_counter()
         for _ in range(a.steps):
             mean = step(k)
             k += 1
-        torch.cuda.synchronize()
+        sync()
         elapsed = time.perf_counter() - start
         if not bool(torch.isfinite(mean).all()):
             raise SystemExit("pf_torch.py: non-finite posterior mean")
         rates.append(a.members * a.particles * a.steps / elapsed)
     print(json.dumps({
-        "implementation": f"pytorch-{a.mode}", "torch": torch.__version__, "device": torch.cuda.get_device_name(),
+        "implementation": f"pytorch-{a.mode}", "torch": torch.__version__, "device": torch.cuda.get_device_name() if device.type == "cuda" else "cpu",
         "members": a.members, "particles": a.particles, "particle_steps_per_s": rates,
         "median": statistics.median(rates), "min": min(rates), "max": max(rates),
         "resamples_per_member_step": resamples / (a.members * k),
