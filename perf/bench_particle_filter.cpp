@@ -29,7 +29,9 @@ void BM_ParticleFilterStep(benchmark::State& state) {
   const Space space;
   const Model model;
   TruthBank<Space, Model> truth(space, model, members, 42);
-  ParticleFilterBank<Space, Model> pf(space, model, members, particles, 43);
+  ParticleFilterOptions options;
+  if (state.range(2) > 0) options.particles_per_thread = static_cast<int>(state.range(2));
+  ParticleFilterBank<Space, Model> pf(space, model, members, particles, 43, options);
   long k = 0;
   for (; k < warmup_steps; ++k) {
     truth.step(k, dt);
@@ -85,15 +87,16 @@ void BM_StreamCopy(benchmark::State& state) {
 }
 
 // M x N: the CPU target (100 x 4096), then M.N = 1e6 .. 1e9; sizes past 1e7 only where a GPU runs them.
-#define KUSHNER_PF_SIZES(b) b->ArgNames({"members", "particles"})->Args({100, 4096})->Args({1000, 1024})->Args({1000, 16384})
+// The third argument (GPU team kernel only) is particles per thread; 0 = the default.
 BENCHMARK_TEMPLATE(BM_ParticleFilterStep, SineModel)->Apply([](benchmark::internal::Benchmark* b) {
-  KUSHNER_PF_SIZES(b);
+  b->ArgNames({"members", "particles", "per_thread"})->Args({100, 4096, 0})->Args({1000, 1024, 0})->Args({1000, 16384, 0});
 #if defined(KOKKOS_ENABLE_CUDA)
-  b->Args({1000, 65536})->Args({10000, 65536})->Args({15259, 65536});
+  b->Args({1000, 65536, 0})->Args({10000, 65536, 0})->Args({15259, 65536, 0});
+  b->Args({1000, 65536, 8})->Args({1000, 65536, 16});
 #endif
 })->UseManualTime();
 BENCHMARK_TEMPLATE(BM_StreamCopy, SineModel)->Apply([](benchmark::internal::Benchmark* b) {
-  KUSHNER_PF_SIZES(b);
+  b->ArgNames({"members", "particles"})->Args({100, 4096})->Args({1000, 1024})->Args({1000, 16384});
 #if defined(KOKKOS_ENABLE_CUDA)
   b->Args({1000, 65536})->Args({15259, 65536});
 #endif

@@ -47,7 +47,7 @@ def report_sizes(out, source):
         size = name.split("/", 1)[1]
         rate, lo, hi, n = med(rows, "particle_steps_per_s")
         gbs = med(rows, "GB_per_s")[0]
-        copy = copies.get("BM_StreamCopy<SineModel>/" + size)
+        copy = copies.get("BM_StreamCopy<SineModel>/" + size.split("/per_thread")[0])
         frac = ""
         if copy:
             bw = med(copy, "GB_per_s")[0]
@@ -55,7 +55,7 @@ def report_sizes(out, source):
         res = med(rows, "resamples_per_member_step")
         print(f"PF step {size}: median {rate:.3g} particle-steps/s (n={n}, spread {lo:.3g}..{hi:.3g}); "
               f"32 B/particle-step = {gbs:.0f} GB/s{frac}; resamples/member-step {res[0]:.2g}")
-        if size == "members:1000/particles:65536":
+        if size == "members:1000/particles:65536/per_thread:0":
             target = rate
     return target
 

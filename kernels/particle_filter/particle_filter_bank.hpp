@@ -46,6 +46,7 @@ struct ParticleFilterOptions {
   ParticleInitialLaw initial_law = ParticleInitialLaw::prior;
   ParticleKernel kernel = ParticleKernel::automatic;
   int team_size = 0;           // team kernel and resampling: 0 = the backend's default
+  int particles_per_thread = 0;  // team kernel: 0 = device_particles_per_thread
 };
 
 template <class ExecSpace, class Model>
@@ -75,9 +76,11 @@ class ParticleFilterBank {
                 (options.kernel == ParticleKernel::automatic && !std::is_same<MemSpace, Kokkos::HostSpace>::value);
     constexpr bool host_memory = std::is_same<MemSpace, Kokkos::HostSpace>::value;
     KUSHNER_REQUIRE(use_team_ || host_memory, "the host block kernel needs host memory");
-    block_size_ = use_team_ ? device_particle_chunk : host_particle_block;
+    team_size_ = options.team_size > 0 ? options.team_size : (host_memory ? 1 : device_particle_team);
+    const int per_thread = options.particles_per_thread > 0 ? options.particles_per_thread : device_particles_per_thread;
+    block_size_ = use_team_ ? (host_memory ? device_particles_per_thread * device_particle_team : team_size_ * per_thread)
+                            : host_particle_block;
     num_blocks_ = (num_particles + block_size_ - 1) / block_size_;
-    team_size_ = options.team_size > 0 ? options.team_size : (std::is_same<MemSpace, Kokkos::HostSpace>::value ? 1 : device_particle_team);
 
     const int n = state_dim;
     x_ = ParticleBank<MemSpace>("kushner::particles", num_particles, num_members, n);

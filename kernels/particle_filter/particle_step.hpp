@@ -37,9 +37,10 @@ namespace kushner {
 /// Particles per block of the host kernel: its arrays stay in L1, and the blocks of all members are the
 /// units of parallel work.
 constexpr int host_particle_block = 256;
-/// Particles per team on a GPU: 256 threads x 4 particles.
-constexpr int device_particle_chunk = 1024;
+/// GPU teams: 256 threads, each streaming 4 particles of the team's chunk (benchmarked against 8 and 16 by
+/// perf/bench_particle_filter.cpp's BM_ParticleFilterStepPerThread).
 constexpr int device_particle_team = 256;
+constexpr int device_particles_per_thread = 4;
 
 /// Everything one step reads and writes. Views are (particle, member[, i]) or (member[, i]), LayoutLeft.
 template <class Model, class MemSpace>
