@@ -35,8 +35,10 @@ struct GridOptions {
   bool truth_law = false;   // start from the truths' law instead of the filters' prior
 };
 
-/// Largest number of nodes one node's mass spreads over per axis.
-constexpr int grid_max_band = 512;
+/// Largest number of nodes one node's mass spreads over per axis (kernels up to sigma / h = 15 at the cut
+/// below; wider ones are cut shorter). Two of these live in each work item's local memory, which a GPU
+/// reserves for every resident thread: keep them small.
+constexpr int grid_max_band = 256;
 /// Gaussian kernels are cut at this many standard deviations (e^{-32} = 1.3e-14 of the peak).
 constexpr double grid_kernel_cut = 8.0;
 
