@@ -30,7 +30,7 @@ using ParticleBank = Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace>;
 template <class T, class MemSpace>
 using BankScalar = Kokkos::View<T*, Kokkos::LayoutLeft, MemSpace>;
 
-constexpr int packed_size(int n) { return n * (n + 1) / 2; }
+KOKKOS_INLINE_FUNCTION constexpr int packed_size(int n) { return n * (n + 1) / 2; }
 
 /// Index of (i, j), i <= j, in the packed upper triangle.
 KOKKOS_INLINE_FUNCTION constexpr int packed_index(int n, int i, int j) {

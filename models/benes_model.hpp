@@ -1,8 +1,12 @@
 #pragma once
-// Benes' model: dx = tanh(x) dt + dw, dy = x dt + r dv. Its conditional density is known in closed form
-// (Benes 1981; /work/notes/references.md section 1), so it validates filters and particle filters against
-// the exact answer; the unit diffusion is part of the Benes condition f' + f^2 = 1 (not a parameter).
-// Defaults (ours, as in the references' check (B)): r = 0.5, x(0) ~ N(0.5, 1) for truths and prior alike.
+// The Benes model (Benes 1981, "Exact finite-dimensional filters for certain diffusions with nonlinear
+// drift", Stochastics 5, 65-92; Bain & Crisan 2009, "Fundamentals of Stochastic Filtering", section 6.1):
+//   dx = tanh(x) dt + dw,   dy = x dt + r dv.
+// Its drift is the gradient of log cosh, which makes the filter finite-dimensional: the posterior is cosh(x)
+// times a Gaussian (kernels/reference/benes_filter.hpp). The transition density is known too,
+//   p(x' | x) = cosh(x') N(x'; x, dt) / (e^{dt/2} cosh x) = w+ N(x + dt, dt) + w- N(x - dt, dt),
+// w+- = (1 +- tanh x) / 2, so the particle filter samples it exactly (sample_exact_transition).
+// Ours: r = 0.5, x(0) ~ N(0.5, 1) for truths and prior alike.
 #include "kernels/math.hpp"
 #include "kernels/small_matrix.hpp"
 #include "models/drift_forms.hpp"
@@ -30,12 +34,12 @@ struct BenesModel : InitialLaw<1> {
 
   KOKKOS_INLINE_FUNCTION Vec<1> drift(double, const Vec<1>& x, const Control&) const { return {{math::tanh(x[0])}}; }
   KOKKOS_INLINE_FUNCTION Mat<1, 1> drift_jacobian(double, const Vec<1>& x, const Control&) const {
-    const double th = math::tanh(x[0]);
-    return {{{1.0 - th * th}}};
+    const double t = math::tanh(x[0]);
+    return {{{1.0 - t * t}}};
   }
   KOKKOS_INLINE_FUNCTION Mat<1, 1> drift_hessian(double, const Vec<1>& x, const Control&, int) const {
-    const double th = math::tanh(x[0]);
-    return {{{-2.0 * th * (1.0 - th * th)}}};
+    const double t = math::tanh(x[0]);
+    return {{{-2.0 * t * (1.0 - t * t)}}};
   }
   KOKKOS_INLINE_FUNCTION Mat<1, 1> diffusion(double, const Vec<1>&) const { return {{{1.0}}}; }
   KOKKOS_INLINE_FUNCTION Vec<1> observation(double, const Vec<1>& x) const { return x; }
@@ -47,6 +51,14 @@ struct BenesModel : InitialLaw<1> {
   KOKKOS_INLINE_FUNCTION SdcDrift<1> sdc_drift(double, const Vec<1>& x) const {
     const double v = x[0];
     return {{{{math::fabs(v) < 1e-4 ? 1.0 - v * v / 3.0 : math::tanh(v) / v}}}, {{0.0}}};
+  }
+
+  /// Exact draw from p(x' | x) above: the sign s = +1 with probability (1 + tanh x) / 2 (from u), then
+  /// x' = x + s dt + sqrt(dt) z.
+  KOKKOS_INLINE_FUNCTION Vec<1> sample_exact_transition(double, const Vec<1>& x, double dt, const Vec<1>& z,
+                                                        double u) const {
+    const double s = 2.0 * u < 1.0 + math::tanh(x[0]) ? 1.0 : -1.0;
+    return {{x[0] + s * dt + math::sqrt(dt) * z[0]}};
   }
 };
 

@@ -1,0 +1,59 @@
+#pragma once
+// Prefix sums of one member's column, computed by a team in a fixed order that does not depend on the team
+// size or the backend: the column is cut into blocks of scan_block_size(n) entries, each block is summed
+// sequentially, the block sums are prefixed sequentially, then each block is prefixed sequentially from its
+// offset. So the cumulative weights -- and the resampled indices -- are the same bits on CPU and GPU.
+// (A tree-ordered parallel_scan would round differently on each backend.)
+#include <Kokkos_Core.hpp>
+
+namespace kushner {
+
+/// At most this many blocks per column: their sums live in team scratch memory (32 KiB of doubles).
+constexpr int max_scan_blocks = 4096;
+
+/// Entries per block: 256, or more when the column has more than 256 * max_scan_blocks entries.
+KOKKOS_INLINE_FUNCTION constexpr int scan_block_size(int n) {
+  const int needed = (n + max_scan_blocks - 1) / max_scan_blocks;
+  return needed > 256 ? needed : 256;
+}
+KOKKOS_INLINE_FUNCTION constexpr int scan_num_blocks(int n) {
+  return (n + scan_block_size(n) - 1) / scan_block_size(n);
+}
+
+/// values(0 .. n-1, member) <- inclusive prefix sums, in place; returns the total on every thread of the
+/// team. `block_sums` is team scratch with at least scan_num_blocks(n) entries. Integer columns are exact.
+template <class Team, class View, class Scratch>
+KOKKOS_INLINE_FUNCTION typename View::non_const_value_type blocked_inclusive_scan(const Team& team, const View& values,
+                                                                                  int member, int n,
+                                                                                  const Scratch& block_sums) {
+  using Value = typename View::non_const_value_type;
+  const int block = scan_block_size(n), num_blocks = scan_num_blocks(n);
+  Kokkos::parallel_for(Kokkos::TeamThreadRange(team, num_blocks), [&](const int b) {
+    const int end = (b + 1) * block < n ? (b + 1) * block : n;
+    Value sum = 0;
+    for (int j = b * block; j < end; ++j) sum += values(j, member);
+    block_sums(b) = static_cast<double>(sum);
+  });
+  team.team_barrier();
+  Kokkos::single(Kokkos::PerTeam(team), [&]() {
+    double offset = 0.0;
+    for (int b = 0; b < num_blocks; ++b) {
+      const double sum = block_sums(b);
+      block_sums(b) = offset;  // exclusive prefix
+      offset += sum;
+    }
+  });
+  team.team_barrier();
+  Kokkos::parallel_for(Kokkos::TeamThreadRange(team, num_blocks), [&](const int b) {
+    const int end = (b + 1) * block < n ? (b + 1) * block : n;
+    Value running = static_cast<Value>(block_sums(b));
+    for (int j = b * block; j < end; ++j) {
+      running += values(j, member);
+      values(j, member) = running;
+    }
+  });
+  team.team_barrier();
+  return values(n - 1, member);
+}
+
+}  // namespace kushner

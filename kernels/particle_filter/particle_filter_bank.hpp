@@ -1,0 +1,228 @@
+#pragma once
+// The particle-filter reference: N particles for each of M members in one structure-of-arrays bank, advanced
+// one observation step at a time. It is the approximation of the true conditional density that every
+// finite-dimensional filter is measured against (SPEC section 4): per member and step it gives the
+// posterior mean and covariance, the effective sample size and the number of resamplings so far.
+//
+//   ParticleFilterBank<Kokkos::DefaultExecutionSpace, SineModel> pf(space, model, M, N, seed);
+//   for (long k = 0; k < steps; ++k) { truth.step(k, dt); pf.step(k, dt, truth.observations()); }
+//   pf.posterior_mean();   // (member, i)
+//
+// A step is three kernels: propagate + weight + block moments (particle_step.hpp), per-member posterior
+// (particle_posterior.hpp), and resampling of the members whose ESS fell below threshold * N
+// (particle_resample_step.hpp). Every sum that reaches an output is taken in a fixed order, so a seed gives
+// the same bits on 1 or 2 threads and on Serial or OpenMP; the GPU differs in the last bits of its math
+// library only.
+#include "kernels/bank.hpp"
+#include "kernels/errors.hpp"
+#include "kernels/linear_algebra.hpp"
+#include "kernels/particle_filter/particle_posterior.hpp"
+#include "kernels/particle_filter/particle_resample_step.hpp"
+#include "kernels/particle_filter/particle_step.hpp"
+#include "kernels/particle_filter/resampling.hpp"
+#include "kernels/particle_filter/resampling_scheme.hpp"
+#include "models/model_checks.hpp"
+
+#include <Kokkos_Core.hpp>
+
+#include <cmath>
+#include <cstdint>
+#include <type_traits>
+
+namespace kushner {
+
+/// Which step kernel runs: the host's SIMD block kernel, or the team kernel written for GPUs (which also
+/// runs on host spaces, for testing it where there is no GPU).
+enum class ParticleKernel { automatic, host_block, team };
+
+/// Where the particles start: the filters' prior N(prior_mean, prior_cov) (default: the reference then
+/// answers "what is the optimal estimate given what the filters assume"), or the truths' law
+/// N(x0_mean, x0_cov).
+enum class ParticleInitialLaw { prior, truth };
+
+struct ParticleFilterOptions {
+  ResamplingScheme scheme = ResamplingScheme::systematic;
+  double ess_threshold = 0.5;  // resample a member when ESS < ess_threshold * N
+  ParticleInitialLaw initial_law = ParticleInitialLaw::prior;
+  ParticleKernel kernel = ParticleKernel::automatic;
+  int team_size = 0;           // team kernel and resampling: 0 = the backend's default
+  int particles_per_thread = 0;  // team kernel: 0 = device_particles_per_thread
+};
+
+template <class ExecSpace, class Model>
+class ParticleFilterBank {
+ public:
+  using MemSpace = typename ExecSpace::memory_space;
+  static constexpr int state_dim = Model::state_dim;
+  static_assert(!Model::discrete_time, "ParticleFilterBank: continuous-time models only (dy increments)");
+
+  ParticleFilterBank(const ExecSpace& space, const Model& model, int num_members, int num_particles,
+                     std::uint32_t seed, ResamplingScheme scheme = ResamplingScheme::systematic,
+                     double ess_threshold = 0.5)
+      : ParticleFilterBank(space, model, num_members, num_particles, seed,
+                           ParticleFilterOptions{scheme, ess_threshold}) {}
+
+  /// Samples the initial particles and computes the time-0 posterior. InputError for sizes < 1 or a
+  /// threshold outside [0, 1].
+  ParticleFilterBank(const ExecSpace& space, const Model& model, int num_members, int num_particles,
+                     std::uint32_t seed, const ParticleFilterOptions& options)
+      : space_(space), model_(model), options_(options), seed_(seed), num_members_(num_members),
+        num_particles_(num_particles) {
+    KUSHNER_INPUT_REQUIRE(num_members >= 1, "members: must be at least 1 (got " << num_members << ")");
+    KUSHNER_INPUT_REQUIRE(num_particles >= 1, "--particles: must be at least 1 (got " << num_particles << ")");
+    KUSHNER_INPUT_REQUIRE(options.ess_threshold >= 0.0 && options.ess_threshold <= 1.0,
+                          "--ess-threshold: must be in [0, 1] (got " << options.ess_threshold << ")");
+    use_team_ = options.kernel == ParticleKernel::team ||
+                (options.kernel == ParticleKernel::automatic && !std::is_same<MemSpace, Kokkos::HostSpace>::value);
+    constexpr bool host_memory = std::is_same<MemSpace, Kokkos::HostSpace>::value;
+    KUSHNER_REQUIRE(use_team_ || host_memory, "the host block kernel needs host memory");
+    team_size_ = options.team_size > 0 ? options.team_size : (host_memory ? 1 : device_particle_team);
+    const int per_thread = options.particles_per_thread > 0 ? options.particles_per_thread : device_particles_per_thread;
+    block_size_ = use_team_ ? (host_memory ? device_particles_per_thread * device_particle_team : team_size_ * per_thread)
+                            : host_particle_block;
+    num_blocks_ = (num_particles + block_size_ - 1) / block_size_;
+
+    const int n = state_dim;
+    x_ = ParticleBank<MemSpace>("kushner::particles", num_particles, num_members, n);
+    x_scratch_ = ParticleBank<MemSpace>("kushner::particles_scratch", num_particles, num_members, n);
+    workspace_.cumulative = decltype(workspace_.cumulative)("kushner::log_weights", num_particles, num_members);
+    workspace_.ancestors = decltype(workspace_.ancestors)("kushner::ancestors", num_particles, num_members);
+    if (options.scheme == ResamplingScheme::residual)
+      workspace_.copies = decltype(workspace_.copies)("kushner::offspring", num_particles, num_members);
+    partials_ = decltype(partials_)("kushner::particle_partials", num_blocks_, num_members, WeightedMoments<n>::size);
+    log_normalizer_ = BankScalar<double, MemSpace>("kushner::log_normalizer", num_members);
+    reference_ = BankVector<MemSpace>("kushner::particle_reference", num_members, n);
+    mean_ = BankVector<MemSpace>("kushner::particle_mean", num_members, n);
+    covariance_ = BankSymmetric<MemSpace>("kushner::particle_covariance", num_members, packed_size(n));
+    ess_ = BankScalar<double, MemSpace>("kushner::ess", num_members);
+    resample_ = BankScalar<int, MemSpace>("kushner::resample_now", num_members);
+    resample_count_ = BankScalar<int, MemSpace>("kushner::resample_count", num_members);
+    status_ = BankScalar<Status, MemSpace>("kushner::particle_status", num_members);
+
+    const bool prior = options.initial_law == ParticleInitialLaw::prior;
+    const Vec<n> initial_mean = prior ? model.prior_mean : model.x0_mean;
+    const Mat<n, n> initial_root = covariance_square_root(prior ? model.prior_cov : model.x0_cov);
+    auto reference = Kokkos::create_mirror_view(reference_);  // moments are taken relative to the initial mean
+    for (int m = 0; m < num_members; ++m) store(reference, m, initial_mean);
+    Kokkos::deep_copy(space_, reference_, reference);
+    ParticleStepData<Model, MemSpace> d = step_data(0.0, 0.0, 0, BankVector<MemSpace>());
+    d.initialize = true;
+    d.initial_mean = initial_mean;
+    d.initial_root = initial_root;
+    run_step_kernels(d);
+  }
+
+  /// Step k: [k dt, (k + 1) dt] with the members' observation increments dy (member, j) over it.
+  void step(long k, double dt, const BankVector<MemSpace>& dy) {
+    KUSHNER_REQUIRE(dy.extent_int(0) == num_members_ && dy.extent_int(1) == Model::obs_dim,
+                    "dy has shape (" << dy.extent(0) << ", " << dy.extent(1) << "), expected (" << num_members_
+                                     << ", " << Model::obs_dim << ")");
+    KUSHNER_REQUIRE(k >= 0 && k < (1L << 32), "step " << k << " outside the counter range");
+    run_step_kernels(step_data(k * dt, dt, static_cast<std::uint32_t>(k), dy));
+  }
+
+  int num_members() const { return num_members_; }
+  int num_particles() const { return num_particles_; }
+  const ParticleFilterOptions& options() const { return options_; }
+
+  /// (member, i): posterior mean after the last step.
+  const BankVector<MemSpace>& posterior_mean() const { return mean_; }
+  /// (member, k): posterior covariance, packed upper triangle (kushner/bank.hpp).
+  const BankSymmetric<MemSpace>& posterior_covariance() const { return covariance_; }
+  /// (member): effective sample size (sum w)^2 / sum w^2 of the last step, before any resampling.
+  const BankScalar<double, MemSpace>& effective_sample_size() const { return ess_; }
+  /// (member): resamplings so far.
+  const BankScalar<int, MemSpace>& resample_count() const { return resample_count_; }
+  /// (member, i): sqrt(P_ii / ESS), the Monte Carlo standard error of the posterior mean as if the ESS
+  /// particles were independent draws from the posterior (Kong, Liu & Wong 1994). It ignores the variance
+  /// that earlier resamplings added, so it understates the error; independent seeds give the honest figure.
+  BankVector<MemSpace> monte_carlo_standard_error() const {
+    BankVector<MemSpace> se("kushner::particle_mc_se", num_members_, state_dim);
+    Kokkos::parallel_for("kushner::particle_mc_se", Kokkos::RangePolicy<ExecSpace>(space_, 0, num_members_),
+                         MonteCarloStandardError<state_dim, MemSpace>{covariance_, ess_, se});
+    return se;
+  }
+  /// (member): ok, or non_finite once every particle of the member has left the finite numbers.
+  const BankScalar<Status, MemSpace>& status() const { return status_; }
+  /// (particle, member, i) and (particle, member): the particles and their log-weights; the normalized weight
+  /// of particle j is exp(log_weights(j, m) - log_normalizer(m)).
+  const ParticleBank<MemSpace>& particles() const { return x_; }
+  const Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace>& log_weights() const { return workspace_.cumulative; }
+  const BankScalar<double, MemSpace>& log_normalizer() const { return log_normalizer_; }
+
+ private:
+  ParticleStepData<Model, MemSpace> step_data(double t, double dt, std::uint32_t step,
+                                              const BankVector<MemSpace>& dy) const {
+    constexpr int p = Model::obs_dim;
+    ParticleStepData<Model, MemSpace> d;
+    d.model = model_;
+    d.x = x_;
+    d.log_weight = workspace_.cumulative;
+    d.log_normalizer = log_normalizer_;
+    d.reference = reference_;
+    d.dy = dy;
+    d.status = status_;
+    d.partials = partials_;
+    const Mat<p, p> r = model_.observation_noise(t);
+    Mat<p, p> root;
+    KUSHNER_REQUIRE(cholesky(r * transpose(r), root), Model::name << ": observation noise R R^T not positive definite at t=" << t);
+    d.observation_precision = cholesky_inverse(root);
+    d.initial_mean = Vec<Model::state_dim>::zero();
+    d.initial_root = Mat<Model::state_dim, Model::state_dim>::zero();
+    d.t = t;
+    d.dt = dt;
+    d.seed = seed_;
+    d.step = step;
+    d.num_particles = num_particles_;
+    d.block_size = block_size_;
+    return d;
+  }
+
+  void run_step_kernels(const ParticleStepData<Model, MemSpace>& d) {
+    constexpr int n = state_dim;
+    if (use_team_) {
+      using Kernel = ParticleTeamStep<Model, ExecSpace>;
+      Kokkos::TeamPolicy<ExecSpace> policy(space_, num_blocks_ * num_members_, team_size_);
+      policy.set_scratch_size(0, Kokkos::PerTeam(Kernel::scratch_bytes(team_size_)));
+      Kokkos::parallel_for("kushner::particle_team_step", policy, Kernel{d, num_blocks_});
+    } else {
+      run_host_block_kernel(d);
+    }
+    Kokkos::parallel_for("kushner::particle_posterior", Kokkos::RangePolicy<ExecSpace>(space_, 0, num_members_),
+                         ParticlePosterior<n, MemSpace>{partials_, num_blocks_, reference_, mean_, covariance_, ess_,
+                                                        log_normalizer_, resample_, resample_count_, status_,
+                                                        options_.ess_threshold * num_particles_});
+    if (d.initialize) return;
+    Kokkos::TeamPolicy<ExecSpace> policy(space_, num_members_, team_size_);
+    policy.set_scratch_size(0, Kokkos::PerTeam(sizeof(double) * scan_num_blocks(num_particles_)));
+    Kokkos::parallel_for("kushner::particle_resample", policy,
+                         ParticleResampleStep<n, ExecSpace>{x_, x_scratch_, workspace_, log_normalizer_, resample_,
+                                                            num_particles_, options_.scheme, seed_, d.step});
+  }
+
+  void run_host_block_kernel(const ParticleStepData<Model, MemSpace>& d) {
+    if constexpr (std::is_same<MemSpace, Kokkos::HostSpace>::value) {
+      Kokkos::parallel_for("kushner::particle_block_step",
+                           Kokkos::RangePolicy<ExecSpace>(space_, 0, num_blocks_ * num_members_),
+                           ParticleBlockStep<Model>{d, num_blocks_});
+    }
+  }
+
+  ExecSpace space_;
+  Model model_;
+  ParticleFilterOptions options_;
+  std::uint32_t seed_;
+  int num_members_, num_particles_;
+  bool use_team_ = false;
+  int block_size_ = 0, num_blocks_ = 0, team_size_ = 1;
+  ParticleBank<MemSpace> x_, x_scratch_;
+  ResamplingWorkspace<MemSpace> workspace_;
+  Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace> partials_;
+  BankScalar<double, MemSpace> log_normalizer_, ess_;
+  BankVector<MemSpace> reference_, mean_;
+  BankSymmetric<MemSpace> covariance_;
+  BankScalar<int, MemSpace> resample_, resample_count_;
+  BankScalar<Status, MemSpace> status_;
+};
+
+}  // namespace kushner

@@ -1,0 +1,35 @@
+#pragma once
+// Which exact (or grid) reference a model has, for `--filters EXACT`: the Kalman filter of the particle
+// filter's discretization for linear models, the Benes closed form for the Benes model, the grid filter for
+// the other models of state dimension 1 or 2 with axis-aligned noise (sine, cubic oscillator, OU). `void`
+// where there is none (dimension 3, discrete time).
+#include "kernels/reference/benes_filter.hpp"
+#include "kernels/reference/grid_filter.hpp"
+#include "kernels/reference/kalman_bucy_reference.hpp"
+#include "models/benes_model.hpp"
+#include "models/linear_model.hpp"
+
+#include <type_traits>
+
+namespace kushner {
+
+template <class ExecSpace, class Model, class = void>
+struct exact_reference {
+  using type = std::conditional_t<!Model::discrete_time && (Model::state_dim == 1 || Model::state_dim == 2),
+                                  GridFilter<ExecSpace, Model>, void>;
+};
+template <class ExecSpace, int N>
+struct exact_reference<ExecSpace, LinearModel<N>> {
+  using type = KalmanBucyReference<ExecSpace, N>;
+};
+template <class ExecSpace>
+struct exact_reference<ExecSpace, BenesModel> {
+  using type = BenesFilter<ExecSpace>;
+};
+
+/// The reference type for Model, or void; every one has step(k, dt, dy), posterior_mean() (member, i),
+/// posterior_covariance() (member, packed) and status().
+template <class ExecSpace, class Model>
+using exact_reference_t = typename exact_reference<ExecSpace, Model>::type;
+
+}  // namespace kushner

@@ -1,0 +1,106 @@
+// The whole particle-filter step (propagate, weight, block moments, posterior and ESS, amortized
+// resampling) in particle-steps per second, sine model, fp64, next to BM_StreamCopy of the bytes a step
+// must move (the memory floor) in the same binary. Observation increments come from a bank of truths that
+// is stepped outside the timed region.
+#include "drivers/simulate_ensemble.hpp"
+#include "kernels/particle_filter/particle_filter_bank.hpp"
+#include "models/sine_model.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+
+namespace kushner {
+namespace {
+
+/// Bytes a step must move per particle: read and write the state (state_dim doubles) and the log-weight.
+template <class Model>
+constexpr double bytes_per_particle_step() {
+  return 8.0 * 2 * (Model::state_dim + 1);
+}
+
+constexpr double dt = 1e-3;
+constexpr int warmup_steps = 200;  // past the first resamplings, which the prior's spread makes frequent
+
+template <class Model>
+void BM_ParticleFilterStep(benchmark::State& state) {
+  using Space = Kokkos::DefaultExecutionSpace;
+  const int members = static_cast<int>(state.range(0)), particles = static_cast<int>(state.range(1));
+  const Space space;
+  const Model model;
+  TruthBank<Space, Model> truth(space, model, members, 42);
+  ParticleFilterOptions options;
+  if (state.range(2) > 0) options.particles_per_thread = static_cast<int>(state.range(2));
+  ParticleFilterBank<Space, Model> pf(space, model, members, particles, 43, options);
+  long k = 0;
+  for (; k < warmup_steps; ++k) {
+    truth.step(k, dt);
+    pf.step(k, dt, truth.observations());
+  }
+  for (auto _ : state) {
+    truth.step(k, dt);
+    space.fence();
+    Kokkos::Timer timer;
+    pf.step(k, dt, truth.observations());
+    space.fence();
+    state.SetIterationTime(timer.seconds());
+    ++k;
+  }
+  using C = benchmark::Counter;
+  const double particle_steps = static_cast<double>(members) * particles;
+  state.counters["particle_steps_per_s"] = C(particle_steps, C::kIsIterationInvariantRate);
+  state.counters["GB_per_s"] = C(1e-9 * bytes_per_particle_step<Model>() * particle_steps, C::kIsIterationInvariantRate);
+  state.counters["bytes_per_particle_step"] = bytes_per_particle_step<Model>();
+  const auto counts = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pf.resample_count());
+  const auto status = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pf.status());
+  const auto mean = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pf.posterior_mean());
+  double resamples = 0.0;
+  for (int m = 0; m < members; ++m) {
+    resamples += counts(m);
+    if (status(m) != Status::ok || !std::isfinite(mean(m, 0))) {
+      state.SkipWithError("non-finite posterior");
+      return;
+    }
+  }
+  state.counters["resamples_per_member_step"] = resamples / (static_cast<double>(members) * k);
+}
+
+/// The physical floor: a deep_copy of the bytes one step moves (half read, half written).
+template <class Model>
+void BM_StreamCopy(benchmark::State& state) {
+  using Space = Kokkos::DefaultExecutionSpace;
+  const long particle_count = state.range(0) * state.range(1);
+  const long doubles = particle_count * static_cast<long>(bytes_per_particle_step<Model>() / 16.0);
+  Kokkos::View<double*, Space::memory_space> a("a", doubles), b("b", doubles);
+  Kokkos::deep_copy(a, 1.0);
+  const Space space;
+  for (auto _ : state) {
+    space.fence();
+    Kokkos::Timer timer;
+    Kokkos::deep_copy(space, b, a);
+    space.fence();
+    state.SetIterationTime(timer.seconds());
+  }
+  using C = benchmark::Counter;
+  state.counters["GB_per_s"] = C(1e-9 * 16.0 * doubles, C::kIsIterationInvariantRate);
+  state.counters["particle_steps_per_s"] = C(static_cast<double>(particle_count), C::kIsIterationInvariantRate);
+}
+
+// M x N: the CPU target (100 x 4096), then M.N = 1e6 .. 1e9; sizes past 1e7 only where a GPU runs them.
+// The third argument (GPU team kernel only) is particles per thread; 0 = the default.
+BENCHMARK_TEMPLATE(BM_ParticleFilterStep, SineModel)->Apply([](benchmark::internal::Benchmark* b) {
+  b->ArgNames({"members", "particles", "per_thread"})->Args({100, 4096, 0})->Args({1000, 1024, 0})->Args({1000, 16384, 0});
+#if defined(KOKKOS_ENABLE_CUDA)
+  b->Args({1000, 65536, 0})->Args({10000, 65536, 0})->Args({15259, 65536, 0});
+  b->Args({1000, 65536, 8})->Args({1000, 65536, 16});
+#endif
+})->UseManualTime();
+BENCHMARK_TEMPLATE(BM_StreamCopy, SineModel)->Apply([](benchmark::internal::Benchmark* b) {
+  b->ArgNames({"members", "particles"})->Args({100, 4096})->Args({1000, 1024})->Args({1000, 16384});
+#if defined(KOKKOS_ENABLE_CUDA)
+  b->Args({1000, 65536})->Args({15259, 65536});
+#endif
+})->UseManualTime();
+
+}  // namespace
+}  // namespace kushner

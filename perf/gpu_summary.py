@@ -1,0 +1,90 @@
+#!/usr/bin/env python3
+"""Summary of perf/run_gpu_benchmarks.sh's results: particle-steps/s of the PF step at every size, bytes
+moved and the fraction of BM_StreamCopy's bandwidth, the ratio to PyTorch (eager and compiled) at
+M = 1000, N = 65536, Kokkos vs Thrust resampling, and the test outcomes.
+
+usage: gpu_summary.py OUT_DIR
+"""
+import json
+import os
+import statistics
+import sys
+
+
+def load(path):
+    try:
+        with open(path) as f:
+            return json.load(f)
+    except (OSError, ValueError):
+        return None
+
+
+def iterations(data, prefix):
+    if not data:
+        return {}
+    out = {}
+    for r in data["benchmarks"]:
+        if r.get("run_type") != "iteration" or not r["name"].startswith(prefix):
+            continue
+        out.setdefault(r["name"].split("/manual_time")[0].split("/repeats")[0], []).append(r)
+    return out
+
+
+def med(rows, key):
+    values = [r[key] for r in rows if key in r]
+    return (statistics.median(values), min(values), max(values), len(values)) if values else None
+
+
+def report_sizes(out, source):
+    """Prints every PF step size in one benchmark file; returns the rate at M = 1000, N = 65536."""
+    pf = load(os.path.join(out, source))
+    steps = iterations(pf, "BM_ParticleFilterStep")
+    copies = iterations(pf, "BM_StreamCopy")
+    target = None
+    if steps:
+        print(f"-- {source} ({pf['context'].get('backend', '?')})")
+    for name, rows in steps.items():
+        size = name.split("/", 1)[1]
+        rate, lo, hi, n = med(rows, "particle_steps_per_s")
+        gbs = med(rows, "GB_per_s")[0]
+        copy = copies.get("BM_StreamCopy<SineModel>/" + size.split("/per_thread")[0])
+        frac = ""
+        if copy:
+            bw = med(copy, "GB_per_s")[0]
+            frac = f", {gbs / bw:.2f} of BM_StreamCopy ({bw:.0f} GB/s, floor {bw / 32e-9:.3g} particle-steps/s)"
+        res = med(rows, "resamples_per_member_step")
+        print(f"PF step {size}: median {rate:.3g} particle-steps/s (n={n}, spread {lo:.3g}..{hi:.3g}); "
+              f"32 B/particle-step = {gbs:.0f} GB/s{frac}; resamples/member-step {res[0]:.2g}")
+        if size == "members:1000/particles:65536/per_thread:0":
+            target = rate
+    return target
+
+
+def main():
+    out = sys.argv[1]
+    gpu_csv = os.path.join(out, "gpu.csv")
+    print("device: " + (open(gpu_csv).read().strip().splitlines()[-1] if os.path.exists(gpu_csv) else "?"))
+    target = report_sizes(out, "bench_compare.json")
+    print("-- PyTorch, same call as bench_compare.json")
+    for mode in ("eager", "compile"):
+        t = load(os.path.join(out, f"torch_{mode}.json"))
+        if t and target:
+            print(f"PyTorch {mode} ({t['torch']}): median {t['median']:.3g} particle-steps/s (spread {t['min']:.3g}.."
+                  f"{t['max']:.3g}); kushner / PyTorch {mode} = {target / t['median']:.3g}x")
+        else:
+            print(f"PyTorch {mode}: no result (see torch_{mode}.log)")
+    if target:
+        print(f"target >= 6e10 particle-steps/s at M=1000, N=65536: {'met' if target >= 6e10 else 'NOT met'} ({target:.3g})")
+    report_sizes(out, "bench_particle_filter.json")
+    rs = load(os.path.join(out, "bench_resampling.json"))
+    for name, rows in iterations(rs, "BM_Resample").items():
+        m = med(rows, "particles_per_s")
+        print(f"{name}: median {m[0]:.3g} particles/s (spread {m[1]:.3g}..{m[2]:.3g})")
+    for t in ("test_resampling", "test_particle_filter", "test_particle_filter_references", "test_grid_filter",
+              "test_particle_snapshot"):
+        r = load(os.path.join(out, f"{t}.json"))
+        print(f"{t}: {r['tests'] - r['failures']}/{r['tests']} passed" if r else f"{t}: no result")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,75 @@
+#!/usr/bin/env bash
+# The particle filter on the GPU machine: builds the CUDA configuration, runs the particle-filter tests
+# (device vs host to 1e-12, systematic indices on every backend, the statistical references) and the
+# benchmarks, with the PyTorch version (perf/pf_torch.py, eager and torch.compile) timed in the same run.
+# Needs: the repository with .deps (Kokkos source, googletest, benchmark, header-only libraries), CUDA,
+# CMake, Python with PyTorch. No network.
+#   OUT=<dir> perf/run_gpu_benchmarks.sh        (results in $OUT; default ./gpu-out)
+# Environment: KUSHNER_JOBS (16), KUSHNER_CUDA_ARCH (AMPERE80: PTX JIT-compiled for Hopper),
+# KUSHNER_REPETITIONS (10), KUSHNER_PHASES (default "build test compare sizes"):
+#   build    configure and build build-cuda/ (kept between calls on the device machine)
+#   test     the particle-filter test binaries (device vs host, systematic indices, statistical references)
+#   compare  M = 1000, N = 65536: kushner's PF step and BM_StreamCopy, then PyTorch eager and torch.compile,
+#            in the same call (the side-by-side ratio)
+#   sizes    every size M.N = 4e5 .. 1e9 (5 repetitions) and Kokkos vs Thrust resampling
+# Where one call has a time limit, run the phases in separate calls, e.g.
+#   KUSHNER_PHASES=build ...; KUSHNER_PHASES=test ...; KUSHNER_PHASES=compare ...; KUSHNER_PHASES=sizes ...
+# Roughly: build 3-5 min at -j16, test 2-3 min, compare 3-4 min (torch.compile compiles first), sizes 3 min.
+set -uo pipefail
+here=$(cd "$(dirname "$0")/.." && pwd)
+out=${OUT:-$here/gpu-out}
+mkdir -p "$out"
+jobs=${KUSHNER_JOBS:-16}
+arch=${KUSHNER_CUDA_ARCH:-AMPERE80}
+reps=${KUSHNER_REPETITIONS:-10}
+build=$here/build-cuda
+phases=" ${KUSHNER_PHASES:-build test compare sizes} "
+want() { [[ "$phases" == *" $1 "* ]]; }
+status=0
+step() { echo "== $(date +%T) $*" | tee -a "$out/steps.log"; }
+run() {  # run NAME CMD...: output to $out/NAME.log, failure recorded, never fatal
+  local name=$1; shift
+  step "$name"
+  local t0=$SECONDS
+  "$@" > "$out/$name.log" 2>&1
+  local rc=$?
+  echo "   $name: exit $rc, $((SECONDS - t0)) s" | tee -a "$out/steps.log"
+  [ $rc -eq 0 ] || status=1
+  return $rc
+}
+
+nvidia-smi --query-gpu=name,memory.total,clocks.max.sm,clocks.max.mem,driver_version --format=csv > "$out/gpu.csv" 2>&1
+git -C "$here" describe --always --dirty --abbrev=12 > "$out/git.txt" 2>&1
+
+if want build; then
+run configure cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON \
+  -DKUSHNER_ENABLE_OPENMP=OFF -DKUSHNER_ENABLE_THRUST=ON -DKUSHNER_CUDA_ARCH="$arch" || { echo "configure failed"; exit 1; }
+run build cmake --build "$build" -j"$jobs" --target test_resampling test_particle_filter \
+  test_particle_filter_references test_grid_filter test_particle_snapshot bench_particle_filter bench_resampling ||
+  { tail -50 "$out/build.log"; exit 1; }
+fi
+
+if want test; then
+  for t in test_resampling test_particle_filter test_particle_filter_references test_grid_filter test_particle_snapshot; do
+    run "$t" "$build/tests/$t" --gtest_output=json:"$out/$t.json"
+  done
+fi
+
+if want compare; then
+  run bench_compare "$build/perf/bench_particle_filter" --benchmark_filter='members:1000/particles:65536/(per_thread:0/)?manual' \
+    --benchmark_repetitions="$reps" --benchmark_enable_random_interleaving=true \
+    --benchmark_out="$out/bench_compare.json" --benchmark_out_format=json
+  run torch_eager python3 "$here/perf/pf_torch.py" --mode eager --members 1000 --particles 65536 --repetitions "$reps"
+  run torch_compile python3 "$here/perf/pf_torch.py" --mode compile --members 1000 --particles 65536 --repetitions "$reps"
+  tail -n 1 "$out/torch_eager.log" > "$out/torch_eager.json" 2>/dev/null
+  tail -n 1 "$out/torch_compile.log" > "$out/torch_compile.json" 2>/dev/null
+fi
+if want sizes; then
+  run bench_particle_filter "$build/perf/bench_particle_filter" --benchmark_repetitions=5 \
+    --benchmark_out="$out/bench_particle_filter.json" --benchmark_out_format=json
+  run bench_resampling "$build/perf/bench_resampling" --benchmark_repetitions=5 \
+    --benchmark_out="$out/bench_resampling.json" --benchmark_out_format=json
+fi
+
+python3 "$here/perf/gpu_summary.py" "$out" | tee "$out/summary.txt"
+exit $status

@@ -1,0 +1,99 @@
+// Quantiles and histograms of the particle cloud, on the prior (a known Gaussian) and after weighting
+// (against the exact Kalman posterior); and the model -> exact reference mapping.
+#include "kernels/particle_filter/particle_snapshot.hpp"
+#include "kernels/particle_filter/reference_distance.hpp"
+#include "kernels/reference/exact_reference.hpp"
+#include "models/cubic_oscillator_model.hpp"
+#include "models/sine_model.hpp"
+#include "tests/reference_comparison.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace kushner {
+namespace {
+
+using test::Space;
+constexpr int particles = 1 << 14;
+
+TEST(ParticleSnapshot, PriorQuantilesAndHistogramMatchTheGaussianWithinFourStandardErrors) {
+  LinearModel<1> model;  // prior N(1, 0.1)
+  ParticleFilterBank<Space, LinearModel<1>> pf(Space(), model, 3, particles, 5);
+  const ParticleSnapshot snap(pf);
+  const double sd = std::sqrt(0.1), phi1 = 0.8413447460685429;  // P(Z < 1)
+  const auto q = snap.quantiles(2, 0, {0.5, phi1, 1.0 - phi1});
+  // SE of a sample p-quantile: sqrt(p (1 - p) / N) / f(x_p), f the density there.
+  const double pdf0 = 1.0 / (sd * std::sqrt(2 * M_PI)), pdf1 = pdf0 * std::exp(-0.5);
+  const double se_median = std::sqrt(0.25 / particles) / pdf0, se_tail = std::sqrt(phi1 * (1 - phi1) / particles) / pdf1;
+  EXPECT_NEAR(q[0], 1.0, 4 * se_median);
+  EXPECT_NEAR(q[1], 1.0 + sd, 4 * se_tail);
+  EXPECT_NEAR(q[2], 1.0 - sd, 4 * se_tail);
+  EXPECT_GT(std::abs(q[1] - (1.0 + 1.1 * sd)), 4 * se_tail);  // power: a 10% wider Gaussian is rejected
+  const auto h = snap.histogram(2, 0, 1.0 - 4 * sd, 1.0 + 4 * sd, 40);
+  double mass = 0.0;
+  for (double d : h) mass += d * (8 * sd / 40);
+  EXPECT_NEAR(mass, 1.0, 1e-3);  // P(|Z| > 4) = 6e-5
+  const double bin = 8 * sd / 40, p_center = pdf0 * bin;  // the two bins around the mean
+  const double se_bin = std::sqrt(p_center * (1 - p_center) / particles) / bin;
+  EXPECT_NEAR(0.5 * (h[19] + h[20]), pdf0, 4 * se_bin + 0.02 * pdf0);  // + curvature of the pdf over a bin
+  EXPECT_THROW(snap.quantiles(0, 0, {1.5}), InputError);
+  EXPECT_THROW(snap.histogram(0, 0, 1.0, 0.0, 3), InputError);
+}
+
+TEST(ParticleSnapshot, PosteriorMedianMatchesKalmanMean) {
+  LinearModel<1> model;
+  const int members = 4, steps = 50;
+  const auto dys = test::record_observations(model, members, steps, 0.01, 3);
+  ParticleFilterBank<Space, LinearModel<1>> pf(Space(), model, members, particles, 6);
+  KalmanBucyReference<Space, 1> kb(Space(), model, members);
+  for (int k = 0; k < steps; ++k) {
+    pf.step(k, 0.01, dys[k]);
+    kb.step(k, 0.01, dys[k]);
+  }
+  const ParticleSnapshot snap(pf);
+  const auto mean = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), kb.posterior_mean());
+  const auto P = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), kb.posterior_covariance());
+  const auto ess = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pf.effective_sample_size());
+  for (int m = 0; m < members; ++m) {
+    const double sd = std::sqrt(P(m, 0));
+    const double se = std::sqrt(0.25 / ess(m)) * sd * std::sqrt(2 * M_PI);  // median of a Gaussian, ESS draws
+    EXPECT_NEAR(snap.quantiles(m, 0, {0.5})[0], mean(m, 0), 4 * se) << m;
+  }
+}
+
+TEST(ReferenceDistance, RmseRefOfAnEstimateOffByAKnownAmount) {
+  // Estimate = reference + (0.3 + 0.1 m) in each of 2 components: D_m = 2 (0.3 + 0.1 m)^2 at every step.
+  const int members = 5;
+  BankVector<test::Mem> reference("reference", members, 2), estimate("estimate", members, 2);
+  auto r = Kokkos::create_mirror_view(reference);
+  auto e = Kokkos::create_mirror_view(estimate);
+  ReferenceDistanceAccumulator<Space> acc(Space(), members);
+  std::vector<double> d(members);
+  for (int k = 0; k < 3; ++k) {
+    for (int m = 0; m < members; ++m)
+      for (int i = 0; i < 2; ++i) {
+        r(m, i) = std::sin(k + m + i);
+        e(m, i) = r(m, i) + 0.3 + 0.1 * m;
+      }
+    if (k == 1) e(4, 0) = std::nan("");  // a diverged estimate is excluded, not averaged in
+    Kokkos::deep_copy(reference, r);
+    Kokkos::deep_copy(estimate, e);
+    acc.add(estimate, reference);
+  }
+  double mean = 0.0, var = 0.0;
+  for (int m = 0; m < members; ++m) d[m] = 2 * std::pow(0.3 + 0.1 * m, 2), mean += d[m] / members;
+  for (int m = 0; m < members; ++m) var += std::pow(d[m] - mean, 2) / (members - 1);
+  const auto result = acc.result();
+  EXPECT_NEAR(result.rmse_ref, std::sqrt(mean), 1e-14);
+  EXPECT_NEAR(result.rmse_ref_se, std::sqrt(var / members) / (2 * std::sqrt(mean)), 1e-14);
+  EXPECT_EQ(result.excluded, 1);
+}
+
+static_assert(std::is_same_v<exact_reference_t<Space, LinearModel<2>>, KalmanBucyReference<Space, 2>>);
+static_assert(std::is_same_v<exact_reference_t<Space, BenesModel>, BenesFilter<Space>>);
+static_assert(std::is_same_v<exact_reference_t<Space, SineModel>, GridFilter<Space, SineModel>>);
+static_assert(std::is_same_v<exact_reference_t<Space, CubicOscillatorModel>, GridFilter<Space, CubicOscillatorModel>>);
+
+}  // namespace
+}  // namespace kushner
