@@ -43,14 +43,17 @@ PY
 import math, sys
 rows = [[l.rstrip("\n").split(",") for l in open(p) if not l.startswith("#")] for p in sys.argv[1:3]]
 assert rows[0][0] == rows[1][0], "headers differ"
-worst = 0.0
+worst, where = 0.0, None
+header = rows[0][0]
 for ra, rb in zip(rows[0][1:], rows[1][1:]):
     assert ra[:2] == rb[:2], "rows differ in time or filter: %s %s" % (ra[:2], rb[:2])
-    for a, b in zip(map(float, ra[2:]), map(float, rb[2:])):
+    for column, a, b in zip(header[2:], map(float, ra[2:]), map(float, rb[2:])):
         if math.isnan(a) and math.isnan(b):
             continue
-        worst = max(worst, abs(a - b) / max(abs(a), abs(b), 1e-300))
-print("largest relative difference cuda vs serial: %.3g" % worst)
+        d = abs(a - b) / max(abs(a), abs(b), 1e-300)
+        if d > worst:
+            worst, where = d, (ra[0], ra[1], column, a, b)
+print("largest relative difference cuda vs serial: %.3g at (t, filter, column, serial, cuda) = %s" % (worst, where))
 sys.exit(worst > 1e-8)
 PY
   fi
