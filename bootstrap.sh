@@ -119,7 +119,7 @@ case "$cmd" in
     cd "$build_dir" && OMP_PROC_BIND=false ctest --output-on-failure -j "$jobs" "$@" ;;
   run)
     install_packages; install_kokkos_source; configure_and_build >&2
-    if [ $# -eq 0 ]; then set -- simulate --model sine --out kushner-out; fi
+    if [ $# -eq 0 ]; then set -- compare --out kushner-out; fi
     exec "$build_dir/kushner" "$@" ;;
   *) die "unknown command '$cmd' (known: run, test, build, deps, bundle)" ;;
 esac

@@ -13,6 +13,10 @@ int run_simulate(const RunOptions& options, const RunContext& context);
 /// `kushner filter`: the bank of truths and filters; writes summary.json and timeseries.csv.
 int run_filter(const FilterOptions& options, const RunContext& context);
 
+/// `kushner compare`: `filter` with the particle reference by default, plus trajectories, density
+/// snapshots, plots and report.md.
+int run_compare(const CompareOptions& options, const RunContext& context);
+
 /// `kushner filters`: every filter and the models it supports (or why not).
 int run_filters_list(bool json);
 

@@ -1,9 +1,11 @@
 #pragma once
 // The bank of truths and filters on one execution space: the truths (drivers/simulate_ensemble.hpp), every
 // filter the model supports as a slot (kernels/filters/filter_slot.hpp) with the selected ones allocated and
-// enabled, the fused step kernel, and the reductions behind the reported metrics. Reductions go through
+// enabled, the fused step kernel, and the reductions behind the reported metrics. Estimators outside the bank
+// (particle filter, exact filters: drivers/reference_estimator.hpp) step on the same dy right after it and are
+// scored like filters; one of them may be the reference that every other estimate is measured against. Reductions go through
 // ensemble_moments (fixed-order blocks), so every number is the same on any number of threads.
-#include "drivers/reference_mean.hpp"
+#include "drivers/reference_estimator.hpp"
 #include "drivers/simulate_ensemble.hpp"
 #include "kernels/ensemble_moments.hpp"
 #include "kernels/filters/filter_bank_step.hpp"
@@ -33,6 +35,7 @@ struct FilterSnapshot {
   double nees = 0.0;  // mean over members with positive definite P
   double nees_se = 0.0;
   double rmse_ref = 0.0;  // against the reference mean, when there is one
+  double rmse_ref_se = 0.0;
   long diverged = 0;      // members whose filter has diverged by now (their truth not escaped)
 };
 
@@ -96,10 +99,25 @@ class FilterBank {
                          typename K::Initial{truths_.state(), slots_});
   }
 
-  /// Scores every filter against `reference` from now on (call before the first step).
-  void set_reference(ReferenceMean<MemSpace>* reference) {
+  /// Scores every filter against `reference` from now on (call before the first step and before
+  /// add_estimator). The bank steps it after each of its own steps (once, also when it is an estimator).
+  void set_reference(ReferenceEstimator<MemSpace>* reference) {
     reference_ = reference;
     if (reference_) score_reference(true);
+  }
+
+  /// Steps `estimator` after every bank step and scores it like a filter, named estimator->name() (call
+  /// before the first step; the bank does not own it).
+  void add_estimator(ReferenceEstimator<MemSpace>* estimator) {
+    KUSHNER_REQUIRE(estimator != nullptr, "add_estimator: null estimator");
+    Estimator e;
+    e.estimator = estimator;
+    e.name = estimator->name();
+    e.slot.enabled = true;
+    e.slot.score = BankVector<MemSpace>("kushner::score_" + e.name, members_, num_score_columns);
+    e.slot.snapshot = BankVector<MemSpace>("kushner::snapshot_" + e.name, members_, num_snapshot_columns);
+    estimators_.push_back(e);
+    score_estimator(estimators_.back(), true);
   }
 
   /// Step k, over [k dt, (k + 1) dt]; `record`: (k + 1) dt is an output time.
@@ -109,10 +127,14 @@ class FilterBank {
                                                                     truths_.observations(), k * dt, dt, seed_, step},
                             filter_model_, truth_status_, slots_, record};
     Kokkos::parallel_for("kushner::filter_bank_step", Kokkos::RangePolicy<ExecSpace>(space_, 0, members_), kernel);
-    if (reference_) {
-      reference_->advance(k, k * dt, dt, truths_.observations());
-      score_reference(record);
+    bool reference_stepped = false;
+    for (auto& e : estimators_) {
+      e.estimator->advance(k, k * dt, dt, truths_.observations());
+      reference_stepped = reference_stepped || e.estimator == reference_;
     }
+    if (reference_ && !reference_stepped) reference_->advance(k, k * dt, dt, truths_.observations());
+    if (reference_) score_reference(record);
+    for (auto& e : estimators_) score_estimator(e, record);
   }
 
   const TruthBank<ExecSpace, Model>& truths() const { return truths_; }
@@ -129,7 +151,21 @@ class FilterBank {
         f(slot);
       }
     });
+    for (const auto& e : estimators_)
+      if (!found && e.name == name) {
+        found = true;
+        f(e.slot);
+      }
     KUSHNER_REQUIRE(found, "filter '" << name << "' is not in this bank");
+  }
+
+  /// The selected filters of the bank (not the outside estimators), in slot order.
+  std::vector<std::string> filter_names() const {
+    std::vector<std::string> names;
+    for_each_slot([&](const auto& slot) {
+      if (slot.enabled) names.push_back(decltype(slot.filter)::name);
+    });
+    return names;
   }
 
   /// The slot of filter type Filter (one the model supports).
@@ -148,7 +184,11 @@ class FilterBank {
       s.rmse_truth_se = rmse.standard_error;
       s.nees = nees.value;
       s.nees_se = nees.standard_error;
-      s.rmse_ref = reference_ ? root_mean(slot.snapshot, snapshot_reference_squared_error).value : std::nan("");
+      const Estimate ref = scored_against_reference(name)
+                               ? root_mean(slot.snapshot, snapshot_reference_squared_error)
+                               : Estimate{std::nan(""), std::nan(""), 0};
+      s.rmse_ref = ref.value;
+      s.rmse_ref_se = ref.standard_error;
       s.diverged = count_status(space_, slot.status, Status::not_positive_definite, truth_status_) +
                    count_status(space_, slot.status, Status::non_finite, truth_status_);
     });
@@ -162,7 +202,7 @@ class FilterBank {
       BankVector<MemSpace> per_member("kushner::member_scores", members_, num_member_score_columns);
       Kokkos::parallel_for("kushner::member_scores", Kokkos::RangePolicy<ExecSpace>(space_, 0, members_),
                            MemberScores<MemSpace>{slot.score, slot.status, truth_status_, per_member,
-                                                  static_cast<double>(points), reference_ != nullptr});
+                                                  static_cast<double>(points), scored_against_reference(name)});
       s.rmse_truth = root_mean(per_member, member_mean_squared_error);
       s.nees = mean(per_member, member_mean_nees);
       s.rmse_ref = root_mean(per_member, member_mean_squared_reference_error);
@@ -206,6 +246,26 @@ class FilterBank {
     Kokkos::deep_copy(P, Ph);
   }
 
+  struct Estimator {
+    ReferenceEstimator<MemSpace>* estimator = nullptr;
+    std::string name;
+    FilterSlot<ExternalEstimator, MemSpace> slot;  // m, P, status: the estimator's views
+  };
+
+  bool scored_against_reference(const std::string& name) const {
+    return reference_ != nullptr && name != reference_->name();
+  }
+
+  void score_estimator(Estimator& e, bool record) {
+    e.slot.m = e.estimator->mean();
+    e.slot.P = e.estimator->covariance();
+    e.slot.status = e.estimator->status();
+    const BankVector<MemSpace> reference =
+        scored_against_reference(e.name) ? reference_->mean() : BankVector<MemSpace>();
+    Kokkos::parallel_for("kushner::estimator_score", Kokkos::RangePolicy<ExecSpace>(space_, 0, members_),
+                         EstimatorScore<n, MemSpace>{e.slot, truths_.state(), reference, truth_status_, record});
+  }
+
   void score_reference(bool record) {
     Kokkos::parallel_for("kushner::filter_bank_reference_score", Kokkos::RangePolicy<ExecSpace>(space_, 0, members_),
                          typename K::Reference{reference_->mean(), truth_status_, slots_, record});
@@ -236,7 +296,8 @@ class FilterBank {
   TruthBank<ExecSpace, Model> truths_;
   BankScalar<Status, MemSpace> truth_status_;
   typename K::Slots slots_;
-  ReferenceMean<MemSpace>* reference_ = nullptr;
+  ReferenceEstimator<MemSpace>* reference_ = nullptr;
+  std::vector<Estimator> estimators_;
 };
 
 }  // namespace kushner

@@ -1,16 +1,31 @@
 #pragma once
-// `kushner filter` for one model type: defined once (filter_command_impl.hpp) and compiled in a few
-// translation units, each for some of the models, so that the filter banks of all models build in parallel.
+// `kushner filter` and `kushner compare` for one model type: defined once (filter_command_impl.hpp) and
+// compiled in a few translation units, each for some of the models, so that the banks of all models build in
+// parallel. `filter` is `compare` without trajectories, density snapshots, plots and report.
 #include "drivers/filter_options.hpp"
+#include "drivers/output_directory.hpp"
 #include "drivers/run_metadata.hpp"
 #include "drivers/run_options.hpp"
 
+#include <nlohmann/json.hpp>
+
+#include <string>
+#include <vector>
+
 namespace kushner {
 
-/// Selects and checks the filters, opens the output directory, runs the bank, writes summary.json and
-/// timeseries.csv.
+/// InputError (one line) for anything the run cannot do with this model: unknown or unsupported filters,
+/// particle-filter settings, trajectory members or density times out of range. Returns the filters in report
+/// order. Call before opening the output directory, so that a refused run writes nothing.
 template <class Model>
-void run_filter_command(const Model& model, const FilterOptions& options, const FilterConfig& config,
-                        const TimeGrid& grid, const RunContext& context);
+std::vector<std::string> check_compare_options(const Model& model, const CompareOptions& options,
+                                               const FilterConfig& config);
+
+/// Runs truths, filters, particle filter and exact filter as `options` asks, writes into `out` summary.json,
+/// timeseries.csv and, as asked, trajectories.csv, density.csv, the plots and report.md; returns the summary.
+/// Needs Kokkos initialized (KokkosSession).
+template <class Model>
+nlohmann::json run_compare_command(const Model& model, const CompareOptions& options, const FilterConfig& config,
+                                   const TimeGrid& grid, const RunContext& context, const OutputDirectory& out);
 
 }  // namespace kushner

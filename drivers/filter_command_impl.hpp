@@ -1,10 +1,16 @@
 #pragma once
+// The run behind `kushner filter` and `kushner compare` for one model type (instantiated per model in the
+// filter_command_*.cpp files): select and check the filters, run the bank with the particle and exact
+// references beside it, write summary.json and timeseries.csv, and for compare the chosen members'
+// trajectories, the density snapshots, the plots and report.md.
 #include "drivers/backend.hpp"
 #include "drivers/csv.hpp"
 #include "drivers/filter_command.hpp"
 #include "drivers/filter_run.hpp"
 #include "drivers/filter_selection.hpp"
 #include "drivers/output_directory.hpp"
+#include "drivers/plots.hpp"
+#include "drivers/trajectory_recorder.hpp"
 #include "models/parameters.hpp"
 
 #include <algorithm>
@@ -16,14 +22,14 @@ namespace detail {
 
 inline std::string filter_timeseries_csv(const FilterReport& report, const RunContext& context) {
   std::string csv = csv_comment(context) + "t,filter,rmse_truth,rmse_truth_se,nees,nees_se,diverged";
-  csv += report.has_reference ? ",rmse_ref\n" : "\n";
+  csv += report.has_reference ? ",rmse_ref,rmse_ref_se\n" : "\n";
   for (std::size_t r = 0; r < report.times.size(); ++r)
     for (std::size_t f = 0; f < report.filters.size(); ++f) {
       const FilterSnapshot& s = report.series[r][f];
       csv += format_number(report.times[r]) + "," + report.filters[f] + "," + format_number(s.rmse_truth) + "," +
              format_number(s.rmse_truth_se) + "," + format_number(s.nees) + "," + format_number(s.nees_se) + "," +
              std::to_string(s.diverged);
-      csv += report.has_reference ? "," + format_number(s.rmse_ref) + "\n" : "\n";
+      csv += report.has_reference ? "," + format_number(s.rmse_ref) + "," + format_number(s.rmse_ref_se) + "\n" : "\n";
     }
   return csv;
 }
@@ -42,10 +48,11 @@ nlohmann::json filter_summary(const FilterReport& report, const FilterConfig& co
                         {"diverged_not_positive_definite", s.not_positive_definite},
                         {"diverged_non_finite", s.non_finite},
                         {"members_scored", s.rmse_truth.members}};
-    if (report.has_reference) {
+    if (report.has_reference && report.filters[f] != report.reference) {
       j["rmse_ref"] = s.rmse_ref.value;
       j["rmse_ref_se"] = s.rmse_ref.standard_error;
     }
+    if (report.estimators.contains(report.filters[f])) j["estimator"] = report.estimators[report.filters[f]];
     if (report.filters[f] == "QLF") {
       const Expectations e = resolve_qlf_expectations<Model>(config.qlf_expectations);
       j["expectations"] = e == Expectations::closed ? "closed" : "cubature";
@@ -67,20 +74,46 @@ nlohmann::json filter_summary(const FilterReport& report, const FilterConfig& co
 }  // namespace detail
 
 template <class Model>
-void run_filter_command(const Model& model, const FilterOptions& options, const FilterConfig& config,
-                        const TimeGrid& grid, const RunContext& context) {
-  const std::vector<std::string> filters = select_filters<Model>(options.filters);
+std::vector<std::string> check_compare_options(const Model& model, const CompareOptions& options,
+                                               const FilterConfig& config) {
+  const std::vector<std::string> filters = select_estimators<Model>(options.filters);
+  if constexpr (has_exact_reference<Model>) {
+    using Grid = GridFilter<Kokkos::DefaultHostExecutionSpace, Model>;
+    if (std::is_same_v<exact_reference_t<Kokkos::DefaultHostExecutionSpace, Model>, Grid> &&
+        std::find(filters.begin(), filters.end(), "EXACT") != filters.end())
+      check_covariance("filter EXACT (grid filter): prior_cov", model.prior_cov, /*allow_singular=*/false);
+  }
   if (std::find(filters.begin(), filters.end(), "QLF") != filters.end())
     resolve_qlf_expectations<Model>(config.qlf_expectations);
-  const OutputDirectory out(options.run.out, "--out");
-  KokkosSession kokkos;
+  particle_settings(options);
+  for (long m : options.trajectory_members)
+    KUSHNER_INPUT_REQUIRE(m >= 0 && m < options.run.members,
+                          "--trajectory-members: member " << m << " is not in 0 .. " << options.run.members - 1);
+  for (double t : options.density_times)
+    KUSHNER_INPUT_REQUIRE(t >= 0.0 && t <= options.run.T,
+                          "--density-times: " << t << " is not in [0, T = " << options.run.T << "]");
+  return filters;
+}
+
+template <class Model>
+nlohmann::json run_compare_command(const Model& model, const CompareOptions& options, const FilterConfig& config,
+                                   const TimeGrid& grid, const RunContext& context, const OutputDirectory& out) {
+  const std::vector<std::string> filters = check_compare_options<Model>(model, options, config);
+  const ParticleSettings particle = particle_settings(options);
+  std::vector<double> density_times = options.density_times;
+  if (density_times.empty() && options.plots) density_times = {0.1 * options.run.T, 0.5 * options.run.T, options.run.T};
+  nlohmann::json summary;
   with_backend(context.backend, [&](const auto& space) {
+    using ExecSpace = std::decay_t<decltype(space)>;
+    TrajectoryRecorder<ExecSpace, Model> recorder(options.trajectory_members, options.run.members, density_times);
     const bool asre = std::find(filters.begin(), filters.end(), "ASRE") != filters.end();
-    Progress progress("filter", grid.steps * (asre ? 3 : 1), !options.run.quiet);
-    const FilterReport report =
-        run_filters(space, model, model, options.run.members, static_cast<std::uint32_t>(options.run.seed), grid,
-                    filters, config, nullptr, &progress);
-    nlohmann::json summary = run_metadata(context);
+    Progress progress(options.plots ? "compare" : "filter", grid.steps * (asre ? 3 : 1), !options.run.quiet);
+    OutputObserver<ExecSpace, Model> observer;
+    if (!options.trajectory_members.empty()) observer = std::ref(recorder);
+    const FilterReport report = run_filters(space, model, model, options.run.members,
+                                            static_cast<std::uint32_t>(options.run.seed), grid, filters, config,
+                                            particle, &progress, observer);
+    summary = run_metadata(context);
     summary["model"] = {
         {"name", Model::name}, {"state_dim", Model::state_dim}, {"parameters", parameter_values(model)}};
     summary["members"] = options.run.members;
@@ -90,10 +123,33 @@ void run_filter_command(const Model& model, const FilterOptions& options, const 
     summary["filters"] = detail::filter_summary<Model>(report, config);
     summary["filter_order"] = report.filters;
     summary["truths_escaped"] = report.truths_escaped;
-    summary["files"] = {"summary.json", "timeseries.csv"};
+    if (report.has_reference) {
+      summary["reference"] = report.estimators[report.reference];
+      summary["reference"]["name"] = report.reference;
+    }
+    std::vector<std::string> files = {"summary.json", "timeseries.csv"};
     out.write("timeseries.csv", detail::filter_timeseries_csv(report, context));
+    if (!options.trajectory_members.empty()) {
+      out.write("trajectories.csv", csv_comment(context) + recorder.trajectories_csv());
+      files.push_back("trajectories.csv");
+    }
+    if (!recorder.density_csv().empty()) {
+      out.write("density.csv", csv_comment(context) + recorder.density_csv());
+      files.push_back("density.csv");
+    }
+    summary["files"] = files;
     out.write("summary.json", summary.dump(2) + "\n");
   });
+  if (options.plots) {  // the plots read summary.json; it then records what they wrote
+    const PlotResult plots = write_plots_and_report(out);
+    summary["plots"] = plots.ok;
+    if (plots.ok)
+      for (const auto& file : plots.files) summary["files"].push_back(file);
+    else
+      summary["plots_error"] = plots.message;
+    out.write("summary.json", summary.dump(2) + "\n");
+  }
+  return summary;
 }
 
 }  // namespace kushner

@@ -4,13 +4,21 @@
 
 namespace kushner {
 
-template void run_filter_command<SineModel>(const SineModel&, const FilterOptions&, const FilterConfig&,
-                                            const TimeGrid&, const RunContext&);
-template void run_filter_command<CubicOscillatorModel>(const CubicOscillatorModel&, const FilterOptions&,
-                                                       const FilterConfig&, const TimeGrid&, const RunContext&);
-template void run_filter_command<BenesModel>(const BenesModel&, const FilterOptions&, const FilterConfig&,
-                                             const TimeGrid&, const RunContext&);
-template void run_filter_command<OuModel>(const OuModel&, const FilterOptions&, const FilterConfig&, const TimeGrid&,
-                                          const RunContext&);
+template std::vector<std::string> check_compare_options<SineModel>(const SineModel&, const CompareOptions&,
+                                                                    const FilterConfig&);
+template nlohmann::json run_compare_command<SineModel>(const SineModel&, const CompareOptions&, const FilterConfig&,
+                                                  const TimeGrid&, const RunContext&, const OutputDirectory&);
+template std::vector<std::string> check_compare_options<CubicOscillatorModel>(const CubicOscillatorModel&, const CompareOptions&,
+                                                                    const FilterConfig&);
+template nlohmann::json run_compare_command<CubicOscillatorModel>(const CubicOscillatorModel&, const CompareOptions&, const FilterConfig&,
+                                                  const TimeGrid&, const RunContext&, const OutputDirectory&);
+template std::vector<std::string> check_compare_options<BenesModel>(const BenesModel&, const CompareOptions&,
+                                                                    const FilterConfig&);
+template nlohmann::json run_compare_command<BenesModel>(const BenesModel&, const CompareOptions&, const FilterConfig&,
+                                                  const TimeGrid&, const RunContext&, const OutputDirectory&);
+template std::vector<std::string> check_compare_options<OuModel>(const OuModel&, const CompareOptions&,
+                                                                    const FilterConfig&);
+template nlohmann::json run_compare_command<OuModel>(const OuModel&, const CompareOptions&, const FilterConfig&,
+                                                  const TimeGrid&, const RunContext&, const OutputDirectory&);
 
 }  // namespace kushner

@@ -4,7 +4,9 @@
 
 namespace kushner {
 
-template void run_filter_command<TerpolymerModel>(const TerpolymerModel&, const FilterOptions&, const FilterConfig&,
-                                                  const TimeGrid&, const RunContext&);
+template std::vector<std::string> check_compare_options<TerpolymerModel>(const TerpolymerModel&, const CompareOptions&,
+                                                                    const FilterConfig&);
+template nlohmann::json run_compare_command<TerpolymerModel>(const TerpolymerModel&, const CompareOptions&, const FilterConfig&,
+                                                  const TimeGrid&, const RunContext&, const OutputDirectory&);
 
 }  // namespace kushner

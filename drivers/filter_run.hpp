@@ -2,18 +2,25 @@
 // A whole filter run over a time grid: the bank of truths and filters stepped from 0 to T, metrics collected
 // at the grid's output times and over the run. ASRE iterates over the whole horizon, so when it is selected
 // a first pass runs the truths with ASRE alone to find, per member, the first iterate whose estimate
-// trajectory changed less than the tolerance; the main pass then reports that iterate. Shared by
-// `kushner filter`, the tests and the benchmarks.
+// trajectory changed less than the tolerance; the main pass then reports that iterate. The particle filter
+// ("PF") and the exact or grid filter ("EXACT") run beside the bank when named among the filters; the
+// particle filter (else the exact filter) is then the reference of rmse_ref. Shared by `kushner filter`,
+// `kushner compare`, the tests and the benchmarks.
+#include "drivers/exact_reference_estimator.hpp"
 #include "drivers/filter_bank.hpp"
+#include "drivers/particle_reference.hpp"
 #include "drivers/progress.hpp"
-#include "drivers/reference_mean.hpp"
 #include "drivers/run_options.hpp"
+
+#include <nlohmann/json.hpp>
 
 #include <Kokkos_Core.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -35,8 +42,20 @@ struct FilterReport {
   std::vector<FilterScores> scores;                 // [filter], over the whole run
   long truths_escaped = 0;                          // members left out of every metric
   bool has_reference = false;
+  std::string reference;                // the reference's name ("PF", "EXACT") when has_reference
+  nlohmann::json estimators = nlohmann::json::object();  // name -> describe() of PF / EXACT
   AsreIterations asre;  // when ASRE is among the filters
 };
+
+/// Names of the estimators that run beside the bank rather than in it.
+inline bool is_outside_estimator(const std::string& name) { return name == "PF" || name == "EXACT"; }
+
+/// Called at t = 0 and at every output time with the bank and the outside estimators (PF, EXACT), e.g. to
+/// record chosen members' trajectories.
+template <class ExecSpace, class Model>
+using OutputObserver = std::function<void(
+    double t, const FilterBank<ExecSpace, Model>&,
+    const std::vector<const ReferenceEstimator<typename ExecSpace::memory_space>*>&)>;
 
 namespace detail {
 
@@ -114,27 +133,53 @@ AsreIterations asre_iterations(const ExecSpace& space, const Model& truth_model,
   return result;
 }
 
-/// Runs the filters `filters` (from select_filters<Model>) over `grid`. The truths follow truth_model, the
-/// filters filter_model. With a `reference`, every filter is also scored against its mean (rmse_ref).
-/// `progress` counts steps of all passes: 3 grid.steps when ASRE is selected, else grid.steps.
+/// Runs the filters `filters` (from select_estimators<Model>: bank filters, then "PF" and/or "EXACT") over
+/// `grid`. The truths follow truth_model, the filters filter_model. With PF or EXACT, every other estimate is
+/// also scored against the reference's mean (rmse_ref). `progress` counts steps of all passes: 3 grid.steps
+/// when ASRE is selected, else grid.steps.
 template <class ExecSpace, class Model>
 FilterReport run_filters(const ExecSpace& space, const Model& truth_model, const Model& filter_model, long members,
                          std::uint32_t seed, const TimeGrid& grid, const std::vector<std::string>& filters,
-                         FilterConfig config, ReferenceMean<typename ExecSpace::memory_space>* reference = nullptr,
-                         Progress* progress = nullptr) {
+                         FilterConfig config, const ParticleSettings& particle = {}, Progress* progress = nullptr,
+                         const OutputObserver<ExecSpace, Model>& observer = {}) {
+  using MemSpace = typename ExecSpace::memory_space;
   FilterReport report;
   report.filters = filters;
-  report.has_reference = reference != nullptr;
+  std::vector<std::string> bank_filters;
+  std::vector<std::unique_ptr<ReferenceEstimator<MemSpace>>> outside;
+  for (const auto& name : filters) {
+    if (!is_outside_estimator(name)) {
+      bank_filters.push_back(name);
+    } else if (name == "PF") {
+      if constexpr (particle_filter_unsupported<Model>() == nullptr)
+        outside.push_back(std::make_unique<ParticleReference<ExecSpace, Model>>(space, filter_model, members, seed,
+                                                                                particle));
+    } else if constexpr (has_exact_reference<Model>) {
+      outside.push_back(std::make_unique<ExactReferenceEstimator<ExecSpace, Model>>(space, filter_model, members));
+    }
+  }
+  KUSHNER_REQUIRE(bank_filters.size() + outside.size() == filters.size(),
+                  "run_filters: PF or EXACT named for a model that has none (select_estimators refuses it)");
   if (std::find(filters.begin(), filters.end(), "ASRE") != filters.end()) {
     report.asre = asre_iterations(space, truth_model, filter_model, members, seed, grid, config, progress);
     config.asre_iterations = report.asre.per_member;
   }
-  FilterBank<ExecSpace, Model> bank(space, truth_model, filter_model, members, seed, filters, config);
-  bank.set_reference(reference);
+  FilterBank<ExecSpace, Model> bank(space, truth_model, filter_model, members, seed, bank_filters, config);
+  std::vector<const ReferenceEstimator<MemSpace>*> outside_view;
+  if (!outside.empty()) {
+    bank.set_reference(outside.front().get());  // PF comes before EXACT
+    report.has_reference = true;
+    report.reference = outside.front()->name();
+  }
+  for (auto& e : outside) {
+    bank.add_estimator(e.get());
+    outside_view.push_back(e.get());
+  }
   auto record = [&](double t) {
     report.times.push_back(t);
     report.series.emplace_back();
     for (const auto& name : filters) report.series.back().push_back(bank.snapshot(name));
+    if (observer) observer(t, bank, outside_view);
   };
   record(0.0);
   std::size_t next_output = 1;
@@ -150,6 +195,7 @@ FilterReport run_filters(const ExecSpace& space, const Model& truth_model, const
   }
   space.fence();
   for (const auto& name : filters) report.scores.push_back(bank.scores(name, grid.steps + 1));
+  for (const auto& e : outside) report.estimators[e->name()] = e->describe();
   report.truths_escaped = bank.truths_escaped();
   return report;
 }

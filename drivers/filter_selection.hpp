@@ -1,6 +1,8 @@
 #pragma once
 // `--filters` on the command line: names to the filters a model supports, in report order, or one clear
 // InputError line ("filter POLY3 does not support model 'car' (drift is not polynomial)").
+#include "drivers/exact_reference_estimator.hpp"
+#include "drivers/particle_reference.hpp"
 #include "kernels/errors.hpp"
 #include "kernels/filters/filter_list.hpp"
 #include "models/linear_model.hpp"
@@ -44,7 +46,7 @@ std::vector<std::string> select_filters(const std::string& list) {
     if (it == support.end()) {
       std::string known;
       for (const auto& f : support) known += (known.empty() ? "" : ", ") + f.name;
-      throw InputError("--filters: unknown filter '" + name + "' (known: " + known + ", or all)");
+      throw InputError("--filters: unknown filter '" + name + "' (known: " + known + ", PF, EXACT, or all)");
     }
     KUSHNER_INPUT_REQUIRE(it->unsupported == nullptr, "filter " << name << " does not support model '" << Model::name
                                                                 << "' (" << it->unsupported << ")");
@@ -53,6 +55,46 @@ std::vector<std::string> select_filters(const std::string& list) {
   for (const auto& f : support)
     if (std::find(requested.begin(), requested.end(), f.name) != requested.end()) ordered.push_back(f.name);
   return ordered;
+}
+
+/// `--filters` with the estimators beside the bank: the bank's filters (select_filters), then "PF" (the
+/// particle filter) and "EXACT" (exact or grid filter) where named. "all" is every bank filter the model
+/// supports plus PF where it applies; EXACT only on request (the grid filter is far slower than the rest).
+template <class Model>
+std::vector<std::string> select_estimators(const std::string& list) {
+  std::string bank_list;
+  bool particle = list == "all" && particle_filter_unsupported<Model>() == nullptr, exact = false;
+  if (list == "all") {
+    bank_list = "all";
+  } else {
+    std::string current;
+    for (std::size_t i = 0; i <= list.size(); ++i) {
+      if (i < list.size() && list[i] != ',') {
+        if (list[i] != ' ') current += list[i];
+        continue;
+      }
+      if (current == "PF") {
+        KUSHNER_INPUT_REQUIRE(particle_filter_unsupported<Model>() == nullptr,
+                              "filter PF does not support model '" << Model::name << "' ("
+                                                                   << particle_filter_unsupported<Model>() << ")");
+        particle = true;
+      } else if (current == "EXACT") {
+        KUSHNER_INPUT_REQUIRE(has_exact_reference<Model>, "filter EXACT does not support model '"
+                                                              << Model::name
+                                                              << "' (no exact filter, and no grid filter above "
+                                                                 "dimension 2 or for discrete time)");
+        exact = true;
+      } else {
+        bank_list += (bank_list.empty() ? "" : ",") + current;
+      }
+      current.clear();
+    }
+    KUSHNER_INPUT_REQUIRE(!list.empty(), "--filters: empty list");
+  }
+  std::vector<std::string> names = bank_list.empty() ? std::vector<std::string>{} : select_filters<Model>(bank_list);
+  if (particle) names.push_back("PF");
+  if (exact) names.push_back("EXACT");
+  return names;
 }
 
 }  // namespace kushner

@@ -13,10 +13,21 @@
 namespace kushner {
 namespace {
 
+/// `kushner compare` with no arguments: Sunahara's sine example, every filter that applies and the particle
+/// reference, sized to finish within a minute on two CPU cores.
+CompareOptions compare_defaults() {
+  CompareOptions o;
+  o.run.members = 200;
+  o.run.dt = 2e-3;
+  o.particles = 1024;
+  return o;
+}
+
 struct Options {
   bool version = false;
   RunOptions simulate;
   FilterOptions filter;
+  CompareOptions compare = compare_defaults();
   bool models_json = false;
   bool filters_json = false;
 };
@@ -30,6 +41,9 @@ std::unique_ptr<CLI::App> make_app(Options& o) {
   app->add_flag("--version", o.version, "print versions, the backend and its threads or device");
   add_run_options(*app->add_subcommand("simulate", "simulate the bank of truths and observations"), o.simulate);
   add_filter_options(*app->add_subcommand("filter", "run the bank of truths and filters side by side"), o.filter);
+  add_compare_options(*app->add_subcommand("compare", "filters against the particle reference, with plots and a "
+                                                      "report (the main job; defaults: the sine model)"),
+                      o.compare);
   app->add_subcommand("models", "list the built-in models and their parameters")
       ->add_flag("--json", o.models_json, "as JSON");
   app->add_subcommand("filters", "list the filters and the models each supports")
@@ -78,6 +92,11 @@ int run(int argc, char** argv) {
     context.seed = static_cast<std::uint32_t>(o.filter.run.seed);
     context.backend = selected_backend();
     return run_filter(o.filter, context);
+  }
+  if (app->got_subcommand("compare")) {
+    context.seed = static_cast<std::uint32_t>(o.compare.run.seed);
+    context.backend = selected_backend();
+    return run_compare(o.compare, context);
   }
   if (app->got_subcommand("simulate")) {
     context.seed = static_cast<std::uint32_t>(o.simulate.seed);

@@ -1,6 +1,6 @@
-// The reference-mean seam (drivers/reference_mean.hpp) that a particle filter plugs into: with the truths
+// The reference seam (drivers/reference_estimator.hpp) that the particle filter plugs into: with the truths
 // themselves as the "reference", every filter's rmse_ref equals its rmse_truth exactly, and a reference that
-// is off by a constant shows up as that offset.
+// is off by a constant shows up as that offset. An estimator added to the bank is scored like a filter.
 #include "drivers/filter_bank.hpp"
 #include "models/sine_model.hpp"
 
@@ -15,15 +15,21 @@ using Space = Kokkos::DefaultExecutionSpace;
 using MemSpace = Space::memory_space;
 
 /// The truths, shifted by `offset`, as a reference mean.
-class ShiftedTruth : public ReferenceMean<MemSpace> {
+class ShiftedTruth : public ReferenceEstimator<MemSpace> {
  public:
   ShiftedTruth(BankVector<MemSpace> truth, double offset)
-      : truth_(truth), mean_("shifted_truth", truth.extent(0), truth.extent(1)), offset_(offset) {
+      : truth_(truth), mean_("shifted_truth", truth.extent(0), truth.extent(1)),
+        covariance_("shifted_truth_cov", truth.extent(0), packed_size(static_cast<int>(truth.extent(1)))),
+        status_("shifted_truth_status", truth.extent(0)), offset_(offset) {
+    Kokkos::deep_copy(covariance_, 1.0);  // a 1-D bank: P = 1
     copy();
   }
-  std::string name() const override { return "shifted-truth"; }
+  std::string name() const override { return "SHIFTED"; }
   void advance(long, double, double, const BankVector<MemSpace>&) override { copy(); }
   BankVector<MemSpace> mean() const override { return mean_; }
+  BankSymmetric<MemSpace> covariance() const override { return covariance_; }
+  BankScalar<Status, MemSpace> status() const override { return status_; }
+  nlohmann::json describe() const override { return {{"kind", "test"}}; }
 
  private:
   void copy() {
@@ -33,11 +39,13 @@ class ShiftedTruth : public ReferenceMean<MemSpace> {
     Kokkos::deep_copy(mean_, host);
   }
   BankVector<MemSpace> truth_, mean_;
+  BankSymmetric<MemSpace> covariance_;
+  BankScalar<Status, MemSpace> status_;
   double offset_;
 };
 
 template <class Bank>
-FilterScores run(Bank& bank, ReferenceMean<MemSpace>& reference, long steps, const char* filter) {
+FilterScores run(Bank& bank, ReferenceEstimator<MemSpace>& reference, long steps, const char* filter) {
   bank.set_reference(&reference);
   for (long k = 0; k < steps; ++k) bank.step(k, 0.01, k + 1 == steps);
   return bank.scores(filter, steps + 1);
@@ -62,6 +70,22 @@ TEST(FilterReference, ShiftedReferenceShowsTheShift) {
   const FilterScores ekf = run(bank, shifted, 200, "EKF");
   EXPECT_NEAR(ekf.rmse_ref.value, 10.0, 2 * ekf.rmse_truth.value);
   EXPECT_GT(ekf.rmse_ref.value, 5.0);
+}
+
+TEST(FilterReference, AddedEstimatorIsScoredLikeAFilter) {
+  // The shifted truth as an outside estimator beside the bank: its rmse_truth is the shift exactly, its NEES
+  // the shift squared (P = 1), and since it is not the reference it gets no rmse_ref.
+  const SineModel model;
+  FilterBank<Space, SineModel> bank(Space(), model, model, 100, 9, {"EKF"}, FilterConfig{});
+  ShiftedTruth shifted(bank.truths().state(), 0.5);
+  bank.add_estimator(&shifted);
+  for (long k = 0; k < 50; ++k) bank.step(k, 0.01, k + 1 == 50);
+  const FilterScores s = bank.scores("SHIFTED", 51);
+  EXPECT_NEAR(s.rmse_truth.value, 0.5, 1e-12);
+  EXPECT_NEAR(s.nees.value, 0.25, 1e-12);
+  EXPECT_TRUE(std::isnan(s.rmse_ref.value));
+  EXPECT_EQ(s.diverged, 0);
+  EXPECT_NEAR(bank.snapshot("SHIFTED").rmse_truth, 0.5, 1e-12);
 }
 
 }  // namespace

@@ -1,7 +1,6 @@
 // Quantiles and histograms of the particle cloud, on the prior (a known Gaussian) and after weighting
 // (against the exact Kalman posterior); and the model -> exact reference mapping.
 #include "kernels/particle_filter/particle_snapshot.hpp"
-#include "kernels/particle_filter/reference_distance.hpp"
 #include "kernels/reference/exact_reference.hpp"
 #include "models/cubic_oscillator_model.hpp"
 #include "models/sine_model.hpp"
@@ -60,34 +59,6 @@ TEST(ParticleSnapshot, PosteriorMedianMatchesKalmanMean) {
     const double se = std::sqrt(0.25 / ess(m)) * sd * std::sqrt(2 * M_PI);  // median of a Gaussian, ESS draws
     EXPECT_NEAR(snap.quantiles(m, 0, {0.5})[0], mean(m, 0), 4 * se) << m;
   }
-}
-
-TEST(ReferenceDistance, RmseRefOfAnEstimateOffByAKnownAmount) {
-  // Estimate = reference + (0.3 + 0.1 m) in each of 2 components: D_m = 2 (0.3 + 0.1 m)^2 at every step.
-  const int members = 5;
-  BankVector<test::Mem> reference("reference", members, 2), estimate("estimate", members, 2);
-  auto r = Kokkos::create_mirror_view(reference);
-  auto e = Kokkos::create_mirror_view(estimate);
-  ReferenceDistanceAccumulator<Space> acc(Space(), members);
-  std::vector<double> d(members);
-  for (int k = 0; k < 3; ++k) {
-    for (int m = 0; m < members; ++m)
-      for (int i = 0; i < 2; ++i) {
-        r(m, i) = std::sin(k + m + i);
-        e(m, i) = r(m, i) + 0.3 + 0.1 * m;
-      }
-    if (k == 1) e(4, 0) = std::nan("");  // a diverged estimate is excluded, not averaged in
-    Kokkos::deep_copy(reference, r);
-    Kokkos::deep_copy(estimate, e);
-    acc.add(estimate, reference);
-  }
-  double mean = 0.0, var = 0.0;
-  for (int m = 0; m < members; ++m) d[m] = 2 * std::pow(0.3 + 0.1 * m, 2), mean += d[m] / members;
-  for (int m = 0; m < members; ++m) var += std::pow(d[m] - mean, 2) / (members - 1);
-  const auto result = acc.result();
-  EXPECT_NEAR(result.rmse_ref, std::sqrt(mean), 1e-14);
-  EXPECT_NEAR(result.rmse_ref_se, std::sqrt(var / members) / (2 * std::sqrt(mean)), 1e-14);
-  EXPECT_EQ(result.excluded, 1);
 }
 
 static_assert(std::is_same_v<exact_reference_t<Space, LinearModel<2>>, KalmanBucyReference<Space, 2>>);

@@ -7,8 +7,8 @@ Reads DIR/summary.json, DIR/timeseries.csv, DIR/trajectories.csv and (1-D models
 by `kushner compare`, and writes PNG and SVG figures plus DIR/report.md. Figures are written through a
 temporary name and renamed, like every kushner output.
 
-  estimates.{png,svg}  one member: truth, each filter's estimate with its +-2 sigma band, the particle mean
-                       and its 5-95% band (first state component; one panel per component up to 3)
+  estimates.{png,svg}  one member: truth, each filter's estimate, the particle mean and its 5-95% band (one
+                       panel per state component, up to 3); the filters' +-2 sigma bands are in trajectories.csv
   errors.{png,svg}     RMS error to the truth against time, per filter (and to the particle mean, dashed)
   rmse_ref.{png,svg}   bar chart of rmse_ref per filter with +-2 standard-error bars
   density.{png,svg}    (1-D models) the particle density at chosen times with each filter's Gaussian
@@ -65,17 +65,15 @@ def plot_estimates(directory, summary, rows, colors):
             ax.fill_between(t, [float(r["lower"]) for r in reference], [float(r["upper"]) for r in reference],
                             color="0.85", label="particle filter 5-95%")
             ax.plot(t, [float(r["estimate"]) for r in reference], color="0.35", lw=1.2, label="particle mean")
-        for name, series in by_series.items():
+        for name, series in by_series.items():  # bands of many filters would hide each other: lines only
             t = [float(r["t"]) for r in series]
             ax.plot(t, [float(r["estimate"]) for r in series], color=colors.get(name), lw=1.0, label=name)
-            ax.fill_between(t, [float(r["lower"]) for r in series], [float(r["upper"]) for r in series],
-                            color=colors.get(name), alpha=0.08)
         if truth:
             ax.plot([float(r["t"]) for r in truth], [float(r["estimate"]) for r in truth], color="k", lw=1.6,
                     ls=":", label="truth")
         ax.set_ylabel(f"x{c}")
         ax.grid(alpha=0.3)
-    axes[0, 0].set_title(f"{summary['model']['name']}: member {member}, estimates with +-2 sigma bands")
+    axes[0, 0].set_title(f"{summary['model']['name']}: member {member}, estimates and the particle filter's 5-95% band")
     axes[-1, 0].set_xlabel("t")
     axes[0, 0].legend(fontsize=7, ncol=4, loc="upper right")
     save(fig, directory, "estimates")
@@ -159,8 +157,13 @@ def write_report(directory, summary, figures):
              f"- members {summary['members']}, T = {summary['T']}, dt = {summary['dt']}"]
     ref = summary.get("reference")
     if ref:
-        lines.append(f"- reference: {ref.get('kind')} with {ref.get('particles')} particles per member, "
-                     f"mean ESS {fmt(ref.get('mean_ess'))}, resampling events {ref.get('resamples')}")
+        if ref.get("kind") == "particle filter":
+            lines.append(f"- reference: particle filter with {ref.get('particles')} particles per member "
+                         f"({ref.get('resampling')} resampling below ESS {ref.get('ess_threshold')} N), mean ESS "
+                         f"{fmt(ref.get('mean_ess'))}, resampling events {ref.get('resamples')}; its own Monte Carlo "
+                         f"error (noise floor of rmse_ref) {fmt(ref.get('noise_floor'))}")
+        else:
+            lines.append(f"- reference: {ref.get('kind')} ({ref.get('note', '')})")
     lines += ["", "## Metrics", "",
               "`rmse_ref`: RMS distance to the particle-filter posterior mean (the approximation error against the "
               "true conditional density); `rmse_truth`: RMS error to the simulated truth; `nees`: mean normalized "
@@ -175,7 +178,8 @@ def write_report(directory, summary, figures):
                      f"{fmt(f.get('rmse_truth'), f.get('rmse_truth_se'))} | {fmt(f.get('nees'), f.get('nees_se'))} | "
                      f"{f.get('diverged', 0)} |")
     lines += ["", "## Figures", ""]
-    captions = {"estimates": "One member: truth, estimates with ±2σ bands, particle mean with its 5–95% band.",
+    captions = {"estimates": "One member: truth, each filter's estimate, particle mean with its 5–95% band "
+                             "(the filters' ±2σ bands are in trajectories.csv).",
                 "errors": "RMS error over members against time: to the truth (solid), to the particle mean (dashed).",
                 "rmse_ref": "Approximation error per filter, with ±2 standard-error bars.",
                 "density": "Particle density (histogram) against each filter's Gaussian, one member."}

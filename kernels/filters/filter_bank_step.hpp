@@ -70,4 +70,30 @@ struct FilterBankReferenceScore {
   }
 };
 
+/// Stands in for the filter type of a slot that scores an estimator outside the bank (a particle filter, an
+/// exact filter): its m, P and status are the estimator's own views.
+struct ExternalEstimator {};
+
+/// After an outside estimator has taken the same step: it is scored like a filter against the truth, and
+/// against the reference mean when it is not the reference itself (`reference` empty then).
+template <int N, class MemSpace>
+struct EstimatorScore {
+  FilterSlot<ExternalEstimator, MemSpace> slot;
+  BankVector<MemSpace> truth, reference;
+  BankScalar<Status, MemSpace> truth_status;
+  bool record;
+
+  KOKKOS_INLINE_FUNCTION void operator()(const int member) const {
+    if (truth_status(member) != Status::ok || slot.status(member) != Status::ok) {
+      if (record) mark_unscored(slot, member);
+      return;
+    }
+    const Mat<N, N> P = load_symmetric<N>(slot.P, member);
+    Mat<N, N> L;
+    const Definiteness definiteness = semidefinite_cholesky(P, L, covariance_tolerance);
+    score_member(slot, member, load<N>(truth, member), load<N>(slot.m, member), L, definiteness, record);
+    if (reference.extent(0) > 0) score_reference<N>(slot, member, reference, true, record);
+  }
+};
+
 }  // namespace kushner

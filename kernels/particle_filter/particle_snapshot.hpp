@@ -1,7 +1,8 @@
 #pragma once
 // On request, at chosen times: the particle filter's marginal quantiles and a density snapshot (histogram)
-// per member. A snapshot copies the particles and normalized weights to the host once; every statistic
-// below is then computed there, in particle order, so it is deterministic. Host code only.
+// per member. A snapshot copies the particles and normalized weights to the host once (of every member, or of
+// a few chosen ones); every statistic below is then computed there, in particle order, so it is
+// deterministic. Host code only.
 #include "kernels/errors.hpp"
 #include "kernels/particle_filter/particle_filter_bank.hpp"
 
@@ -10,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <utility>
 #include <vector>
 
 namespace kushner {
@@ -25,6 +27,31 @@ class ParticleSnapshot {
     const auto ln = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pf.log_normalizer());
     for (int m = 0; m < members_; ++m)
       for (int j = 0; j < particles_; ++j) w_(j, m) = std::exp(lw(j, m) - ln(m));
+    column_.resize(members_);
+    std::iota(column_.begin(), column_.end(), 0);
+  }
+
+  /// Only the members in `members` (each in range): what a run that follows a few members needs, without
+  /// copying the whole bank.
+  template <class ExecSpace, class Model>
+  ParticleSnapshot(const ParticleFilterBank<ExecSpace, Model>& pf, const std::vector<int>& members)
+      : members_(pf.num_members()), particles_(pf.num_particles()), dim_(Model::state_dim),
+        x_("kushner::snapshot_particles", particles_, members.size(), dim_),
+        w_("kushner::snapshot_weights", particles_, members.size()), column_(members_, -1) {
+    const auto ln = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pf.log_normalizer());
+    for (std::size_t k = 0; k < members.size(); ++k) {
+      const int m = members[k];
+      KUSHNER_REQUIRE(m >= 0 && m < members_, "snapshot: member " << m << " out of range");
+      column_[m] = static_cast<int>(k);
+      const auto lw = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(),
+                                                          Kokkos::subview(pf.log_weights(), Kokkos::ALL, m));
+      const auto x = Kokkos::create_mirror_view_and_copy(
+          Kokkos::HostSpace(), Kokkos::subview(pf.particles(), Kokkos::ALL, m, Kokkos::ALL));
+      for (int j = 0; j < particles_; ++j) {
+        w_(j, k) = std::exp(lw(j) - ln(m));
+        for (int i = 0; i < dim_; ++i) x_(j, k, i) = x(j, i);
+      }
+    }
   }
 
   int num_members() const { return members_; }
@@ -32,21 +59,21 @@ class ParticleSnapshot {
   /// Weighted quantiles of component i of member m at probabilities `p` (each in [0, 1]): the smallest
   /// particle value whose cumulative weight reaches p (the inverse of the weighted empirical CDF).
   std::vector<double> quantiles(int member, int i, const std::vector<double>& p) const {
-    check(member, i);
+    const int c = column(member, i);  // the snapshot's column of the member
     std::vector<int> order(particles_);
     std::iota(order.begin(), order.end(), 0);
-    std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return x_(a, member, i) < x_(b, member, i); });
+    std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return x_(a, c, i) < x_(b, c, i); });
     double total = 0.0;
-    for (int j = 0; j < particles_; ++j) total += w_(j, member);
+    for (int j = 0; j < particles_; ++j) total += w_(j, c);
     std::vector<double> out;
     for (double q : p) {
       KUSHNER_INPUT_REQUIRE(q >= 0.0 && q <= 1.0, "quantile: probability must be in [0, 1] (got " << q << ")");
-      double c = 0.0;
-      double value = x_(order.back(), member, i);
+      double cumulative = 0.0;
+      double value = x_(order.back(), c, i);
       for (int j : order) {
-        c += w_(j, member) / total;
-        if (c >= q && w_(j, member) > 0.0) {
-          value = x_(j, member, i);
+        cumulative += w_(j, c) / total;
+        if (cumulative >= q && w_(j, c) > 0.0) {
+          value = x_(j, c, i);
           break;
         }
       }
@@ -58,30 +85,33 @@ class ParticleSnapshot {
   /// Histogram of component i of member m: the posterior probability of each of `bins` equal bins on
   /// [lo, hi), divided by the bin width (a density); mass outside [lo, hi) is left out.
   std::vector<double> histogram(int member, int i, double lo, double hi, int bins) const {
-    check(member, i);
+    const int c = column(member, i);  // the snapshot's column of the member
     KUSHNER_INPUT_REQUIRE(hi > lo && bins >= 1, "histogram: need lo < hi and bins >= 1 (got " << lo << ", " << hi
                                                                                           << ", " << bins << ")");
     std::vector<double> density(bins, 0.0);
     double total = 0.0;
-    for (int j = 0; j < particles_; ++j) total += w_(j, member);
+    for (int j = 0; j < particles_; ++j) total += w_(j, c);
     const double width = (hi - lo) / bins;
     for (int j = 0; j < particles_; ++j) {
-      const double v = x_(j, member, i);
+      const double v = x_(j, c, i);
       if (!(v >= lo && v < hi)) continue;
       const int b = std::min(bins - 1, static_cast<int>((v - lo) / width));
-      density[b] += w_(j, member) / total / width;
+      density[b] += w_(j, c) / total / width;
     }
     return density;
   }
 
  private:
-  void check(int member, int i) const {
-    KUSHNER_REQUIRE(member >= 0 && member < members_ && i >= 0 && i < dim_,
-                    "member " << member << " component " << i << " out of range");
+  /// The snapshot's column of `member`, after checking that the snapshot holds it.
+  int column(int member, int i) const {
+    KUSHNER_REQUIRE(member >= 0 && member < members_ && i >= 0 && i < dim_ && column_[member] >= 0,
+                    "member " << member << " component " << i << " not in this snapshot");
+    return column_[member];
   }
   int members_, particles_, dim_;
   Kokkos::View<double***, Kokkos::LayoutLeft, Kokkos::HostSpace> x_;
   Kokkos::View<double**, Kokkos::LayoutLeft, Kokkos::HostSpace> w_;
+  std::vector<int> column_;  // member -> column of x_ and w_, -1 when not copied
 };
 
 }  // namespace kushner

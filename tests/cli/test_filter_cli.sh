@@ -22,7 +22,7 @@ expect_refused "filter KB does not support model 'sine' (model is not linear)" f
 expect_refused "filter QLF does not support model 'car' (the drift has no Gaussian expectation)" filter --model car --filters QLF
 expect_refused "filter BILIN does not support model 'cubic-oscillator' (drift is not bilinear)" \
   filter --model cubic-oscillator --filters BILIN
-expect_refused "--filters: unknown filter 'UKF' (known: KB, EKF, EKF-DS, SOF, SOF-B, QLF, POLY3, POLY4, BILIN, MIXED, ASRE, KBL, or all)" \
+expect_refused "--filters: unknown filter 'UKF' (known: KB, EKF, EKF-DS, SOF, SOF-B, QLF, POLY3, POLY4, BILIN, MIXED, ASRE, KBL, PF, EXACT, or all)" \
   filter --model sine --filters EKF,UKF
 expect_refused "--filters: empty name in 'EKF,,SOF'" filter --model sine --filters EKF,,SOF
 expect_refused "--model: 'clark-linear' is a discrete-time model; \`kushner filter\` runs the continuous-time filters" \

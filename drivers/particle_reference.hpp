@@ -1,0 +1,102 @@
+#pragma once
+// The particle filter as the bank's reference estimator: N particles per member driven by the same dy as the
+// filters, started from the filters' prior (so it answers "what is the optimal estimate under the filters'
+// assumptions"). Also keeps, per member, sums over steps of the effective sample size and of trace(P) / ESS,
+// the squared Monte Carlo error of the particle mean (Kong, Liu & Wong 1994): rmse_ref cannot tell apart
+// filters closer to the particle mean than its root mean, the reference's noise floor. Reduced on the host
+// in member order, so the figures are the same on any number of threads.
+#include "drivers/reference_estimator.hpp"
+#include "kernels/particle_filter/particle_filter_bank.hpp"
+
+#include <Kokkos_Core.hpp>
+
+#include <cmath>
+#include <cstdint>
+
+namespace kushner {
+
+/// Largest state dimension of the particle filter: its GPU kernel keeps each thread's weighted moments
+/// (3 + n + n(n+1)/2 doubles) in shared memory, which a 10-state model would overflow.
+constexpr int max_particle_filter_dim = 4;
+
+/// Why the particle filter cannot run Model, or nullptr.
+template <class Model>
+constexpr const char* particle_filter_unsupported() {
+  if (Model::discrete_time) return "discrete-time model";
+  if (Model::state_dim > max_particle_filter_dim) return "state dimension above 4";
+  return nullptr;
+}
+
+/// Particle-filter settings of `kushner filter` and `kushner compare`.
+struct ParticleSettings {
+  int particles = 1024;
+  ParticleFilterOptions options;
+};
+
+template <int N, class MemSpace>
+struct AccumulateEss {
+  BankScalar<double, MemSpace> ess;
+  BankSymmetric<MemSpace> covariance;
+  BankVector<MemSpace> sums;  // (member, 0): sum of ESS; (member, 1): sum of trace(P) / ESS
+  KOKKOS_INLINE_FUNCTION void operator()(const int member) const {
+    double trace = 0.0;
+    for (int i = 0; i < N; ++i) trace += covariance(member, packed_index(N, i, i));
+    sums(member, 0) += ess(member);
+    sums(member, 1) += trace / ess(member);
+  }
+};
+
+template <class ExecSpace, class Model>
+class ParticleReference final : public ReferenceEstimator<typename ExecSpace::memory_space> {
+ public:
+  using MemSpace = typename ExecSpace::memory_space;
+
+  ParticleReference(const ExecSpace& space, const Model& model, long members, std::uint32_t seed,
+                    const ParticleSettings& settings)
+      : space_(space),
+        pf_(space, model, static_cast<int>(members), settings.particles, seed, settings.options),
+        sums_("kushner::particle_reference_sums", members, 2) {}
+
+  std::string name() const override { return "PF"; }
+  void advance(long k, double, double dt, const BankVector<MemSpace>& dy) override {
+    pf_.step(k, dt, dy);
+    Kokkos::parallel_for("kushner::accumulate_ess", Kokkos::RangePolicy<ExecSpace>(space_, 0, pf_.num_members()),
+                         AccumulateEss<Model::state_dim, MemSpace>{pf_.effective_sample_size(),
+                                                                   pf_.posterior_covariance(), sums_});
+    ++steps_;
+  }
+  BankVector<MemSpace> mean() const override { return pf_.posterior_mean(); }
+  BankSymmetric<MemSpace> covariance() const override { return pf_.posterior_covariance(); }
+  BankScalar<Status, MemSpace> status() const override { return pf_.status(); }
+
+  nlohmann::json describe() const override {
+    space_.fence();
+    const auto sums = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sums_);
+    const auto resamples = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pf_.resample_count());
+    double ess_total = 0.0, squared_error_total = 0.0;
+    long resample_total = 0;
+    for (int m = 0; m < pf_.num_members(); ++m) {
+      if (!std::isfinite(sums(m, 0)) || !std::isfinite(sums(m, 1))) continue;  // a member that left the numbers
+      ess_total += sums(m, 0), squared_error_total += sums(m, 1), resample_total += resamples(m);
+    }
+    const double member_steps = static_cast<double>(pf_.num_members()) * steps_;
+    return {{"kind", "particle filter"},
+            {"particles", pf_.num_particles()},
+            {"resampling", to_string(pf_.options().scheme)},
+            {"ess_threshold", pf_.options().ess_threshold},
+            {"mean_ess", steps_ > 0 ? ess_total / member_steps : std::nan("")},
+            {"noise_floor", steps_ > 0 ? std::sqrt(squared_error_total / member_steps) : std::nan("")},
+            {"resamples", resample_total},
+            {"resamples_per_member_step", steps_ > 0 ? resample_total / member_steps : std::nan("")}};
+  }
+
+  const ParticleFilterBank<ExecSpace, Model>& bank() const { return pf_; }
+
+ private:
+  ExecSpace space_;
+  ParticleFilterBank<ExecSpace, Model> pf_;
+  BankVector<MemSpace> sums_;
+  long steps_ = 0;
+};
+
+}  // namespace kushner

@@ -1,0 +1,59 @@
+#include "drivers/plots.hpp"
+
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#ifndef KUSHNER_SOURCE_DIR
+#error "KUSHNER_SOURCE_DIR must name the source tree (it holds drivers/plots/compare_plots.py)"
+#endif
+
+namespace kushner {
+
+namespace {
+
+std::string shell_quote(const std::string& s) {
+  std::string quoted = "'";
+  for (char c : s) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return quoted + "'";
+}
+
+std::string python_interpreter() {
+  if (const char* p = std::getenv("KUSHNER_PYTHON"); p && *p) return p;
+  if (std::filesystem::exists("/usr/bin/python3")) return "/usr/bin/python3";
+  return "python3";
+}
+
+}  // namespace
+
+PlotResult write_plots_and_report(const OutputDirectory& out) {
+  PlotResult result;
+  const std::filesystem::path script = std::filesystem::path(KUSHNER_SOURCE_DIR) / "drivers/plots/compare_plots.py";
+  const std::string command = shell_quote(python_interpreter()) + " " + shell_quote(script.string()) + " " +
+                              shell_quote(out.path().string()) + " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) {
+    result.message = "could not start " + python_interpreter();
+    return result;
+  }
+  std::string output;
+  std::array<char, 512> buffer;
+  while (std::fgets(buffer.data(), buffer.size(), pipe)) output += buffer.data();
+  const int status = pclose(pipe);
+  if (status != 0) {
+    while (!output.empty() && output.back() == '\n') output.pop_back();
+    const auto last = output.rfind('\n');
+    result.message = "plotting failed: " + (last == std::string::npos ? output : output.substr(last + 1));
+    return result;
+  }
+  result.ok = true;
+  for (const char* name : {"estimates", "errors", "rmse_ref", "density"})
+    for (const char* ext : {".png", ".svg"})
+      if (std::filesystem::exists(out.path() / (std::string(name) + ext))) result.files.push_back(name + std::string(ext));
+  result.files.push_back("report.md");
+  return result;
+}
+
+}  // namespace kushner

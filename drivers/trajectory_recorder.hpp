@@ -1,0 +1,140 @@
+#pragma once
+// What `kushner compare` shows for a few chosen members, recorded at the run's output times: the truth, each
+// filter's estimate with its +-2 sigma band, the particle mean with its 5-95% band (trajectories.csv); and for
+// 1-D models the particle density of the first chosen member against each filter's Gaussian at chosen times
+// (density.csv). Only those members are copied to the host, so it costs little next to the run.
+#include "drivers/csv.hpp"
+#include "drivers/filter_bank.hpp"
+#include "drivers/particle_reference.hpp"
+#include "drivers/reference_estimator.hpp"
+#include "drivers/run_metadata.hpp"
+#include "kernels/errors.hpp"
+#include "kernels/particle_filter/particle_snapshot.hpp"
+
+#include <Kokkos_Core.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace kushner {
+
+template <class ExecSpace, class Model>
+class TrajectoryRecorder {
+ public:
+  using MemSpace = typename ExecSpace::memory_space;
+  static constexpr int n = Model::state_dim;
+  static constexpr int density_bins = 80;
+
+  /// `members`: the members to follow (each below `num_members`); `density_times`: for 1-D models, the
+  /// snapshots are taken at the first output time at or after each of them.
+  TrajectoryRecorder(const std::vector<long>& members, long num_members, std::vector<double> density_times)
+      : members_(members), density_times_(std::move(density_times)) {
+    for (long m : members_)
+      KUSHNER_INPUT_REQUIRE(m >= 0 && m < num_members, "--trajectory-members: member " << m << " is not in 0 .. "
+                                                                                        << num_members - 1);
+    std::sort(density_times_.begin(), density_times_.end());
+    trajectories_ = "member,t,component,series,estimate,lower,upper\n";
+    density_ = "t,member,x,series,density\n";
+  }
+
+  void operator()(double t, const FilterBank<ExecSpace, Model>& bank,
+                  const std::vector<const ReferenceEstimator<MemSpace>*>& outside) {
+    std::vector<int> members(members_.begin(), members_.end());
+    if (members.empty()) return;
+    const ReferenceEstimator<MemSpace>* pf = nullptr;  // the particle filter among `outside`, if any
+    std::optional<ParticleSnapshot> snapshot;          // its particles of `members`
+    if constexpr (particle_filter_unsupported<Model>() == nullptr)
+      for (const auto* e : outside)
+        if (const auto* p = dynamic_cast<const ParticleReference<ExecSpace, Model>*>(e); p && !pf) {
+          pf = e;
+          snapshot.emplace(p->bank(), members);
+        }
+    const bool density =
+        n == 1 && pf && next_density_ < density_times_.size() && t >= density_times_[next_density_] - 1e-9;
+    for (int member : members) {
+      const auto x = row(bank.truths().state(), member);
+      for (int i = 0; i < n; ++i) add_trajectory(member, t, i, "truth", x(i), x(i), x(i));
+      for (const auto& name : bank.filter_names())
+        bank.with_slot(name, [&](const auto& slot) { add_gaussian(member, t, name, row(slot.m, member),
+                                                                  row(slot.P, member)); });
+      for (const auto* e : outside) {
+        if (e == pf) {
+          const auto mean = row(pf->mean(), member);
+          for (int i = 0; i < n; ++i) {
+            const std::vector<double> band = snapshot->quantiles(member, i, {0.05, 0.95});
+            add_trajectory(member, t, i, "PF", mean(i), band[0], band[1]);
+          }
+        } else {
+          add_gaussian(member, t, e->name(), row(e->mean(), member), row(e->covariance(), member));
+        }
+      }
+    }
+    if (density) {
+      while (next_density_ < density_times_.size() && t >= density_times_[next_density_] - 1e-9) ++next_density_;
+      add_density(t, members.front(), bank, outside, *pf, *snapshot);
+    }
+  }
+
+  const std::string& trajectories_csv() const { return trajectories_; }
+  /// Empty unless a density snapshot was taken (1-D model with the particle filter).
+  std::string density_csv() const { return density_taken_ ? density_ : std::string(); }
+
+ private:
+  template <class View>
+  static auto row(const View& v, long member) {
+    return Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), Kokkos::subview(v, member, Kokkos::ALL));
+  }
+
+  void add_trajectory(long member, double t, int i, const std::string& series, double estimate, double lower,
+                      double upper) {
+    trajectories_ += std::to_string(member) + "," + format_number(t) + "," + std::to_string(i) + "," + series + "," +
+                     format_number(estimate) + "," + format_number(lower) + "," + format_number(upper) + "\n";
+  }
+
+  template <class MeanRow, class CovarianceRow>
+  void add_gaussian(long member, double t, const std::string& name, const MeanRow& m, const CovarianceRow& P) {
+    for (int i = 0; i < n; ++i) {
+      const double sd = std::sqrt(std::max(0.0, P(packed_index(n, i, i))));
+      add_trajectory(member, t, i, name, m(i), m(i) - 2.0 * sd, m(i) + 2.0 * sd);
+    }
+  }
+
+  void add_density(double t, int member, const FilterBank<ExecSpace, Model>& bank,
+                   const std::vector<const ReferenceEstimator<MemSpace>*>& outside,
+                   const ReferenceEstimator<MemSpace>& pf, const ParticleSnapshot& snapshot) {
+    density_taken_ = true;
+    // The range holds the particle mass (0.1%-99.9%) with a margin, so that the filters' bells show too.
+    const std::vector<double> q = snapshot.quantiles(member, 0, {0.001, 0.999});
+    const double margin = 0.25 * std::max(q[1] - q[0], 1e-12);
+    const double lo = q[0] - margin, hi = q[1] + margin, width = (hi - lo) / density_bins;
+    const std::vector<double> histogram = snapshot.histogram(member, 0, lo, hi, density_bins);
+    auto add = [&](const std::string& series, double x, double d) {
+      density_ += format_number(t) + "," + std::to_string(member) + "," + format_number(x) + "," + series + "," +
+                  format_number(d) + "\n";
+    };
+    for (int b = 0; b < density_bins; ++b) add("PF", lo + (b + 0.5) * width, histogram[b]);
+    auto bell = [&](const std::string& name, double mean, double variance) {
+      if (!(variance > 0.0)) return;
+      for (int b = 0; b < density_bins; ++b) {
+        const double x = lo + (b + 0.5) * width, z = (x - mean) / std::sqrt(variance);
+        add(name, x, std::exp(-0.5 * z * z) / std::sqrt(2.0 * M_PI * variance));
+      }
+    };
+    for (const auto& name : bank.filter_names())
+      bank.with_slot(name, [&](const auto& slot) { bell(name, row(slot.m, member)(0), row(slot.P, member)(0)); });
+    for (const auto* e : outside)
+      if (e != &pf) bell(e->name(), row(e->mean(), member)(0), row(e->covariance(), member)(0));
+    add("truth", row(bank.truths().state(), member)(0), 0.0);
+  }
+
+  std::vector<long> members_;
+  std::vector<double> density_times_;
+  std::size_t next_density_ = 0;
+  bool density_taken_ = false;
+  std::string trajectories_, density_;
+};
+
+}  // namespace kushner

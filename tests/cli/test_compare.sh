@@ -1,0 +1,89 @@
+#!/usr/bin/env bash
+# `kushner compare` and the particle/exact references on the command line: every artefact is written, each
+# filter gets rmse_ref against the particle filter, EXACT is scored against it too, and bad input is refused
+# with one line, exit 2 and nothing written.
+set -euo pipefail
+kushner=$1
+source "$(dirname "$0")/lib.sh"
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+small=(--members 12 --particles 256 --T 1 --dt 1e-2 --output-points 20 --quiet)
+
+run_kushner "$work/c" compare "${small[@]}" --out "$work/c1"
+[ "$rc" -eq 0 ] || fail "compare failed: $(cat "$work/c.err")"
+for f in summary.json timeseries.csv trajectories.csv density.csv report.md estimates.png estimates.svg errors.png \
+         rmse_ref.png density.png density.svg; do
+  [ -s "$work/c1/$f" ] || fail "compare did not write $f"
+done
+ls "$work/c1" | grep -q '\.tmp' && fail "temporary files left behind"
+python3 - "$work/c1" <<'PY' || fail "compare summary.json or CSV files incomplete"
+import csv, json, math, os, sys
+d = sys.argv[1]
+s = json.load(open(os.path.join(d, "summary.json")))
+assert s["model"]["name"] == "sine", s["model"]
+assert s["reference"]["kind"] == "particle filter" and s["reference"]["particles"] == 256, s["reference"]
+assert s["reference"]["mean_ess"] > 0 and s["reference"]["noise_floor"] > 0, s["reference"]
+filters = s["filters"]
+assert "PF" in filters and "rmse_ref" not in filters["PF"], "the reference has no rmse_ref of its own"
+for name in ("EKF", "SOF", "QLF", "KBL", "ASRE"):
+    f = filters[name]
+    assert math.isfinite(f["rmse_ref"]) and f["rmse_ref"] > 0 and math.isfinite(f["rmse_ref_se"]), (name, f)
+    assert math.isfinite(f["rmse_truth"]) and math.isfinite(f["nees"]), (name, f)
+# KBL (linearized at 0) is far from the conditional mean on the sine model; QLF is close to it.
+assert filters["KBL"]["rmse_ref"] > filters["QLF"]["rmse_ref"], filters
+rows = list(csv.DictReader(l for l in open(os.path.join(d, "trajectories.csv")) if not l.startswith("#")))
+series = {r["series"] for r in rows}
+assert {"truth", "PF", "QLF", "EKF"} <= series, series
+assert {r["member"] for r in rows} == {"0", "1", "2"}, {r["member"] for r in rows}
+for r in rows:
+    assert float(r["lower"]) <= float(r["estimate"]) <= float(r["upper"]), r
+dens = list(csv.DictReader(l for l in open(os.path.join(d, "density.csv")) if not l.startswith("#")))
+assert len({r["t"] for r in dens}) == 3, {r["t"] for r in dens}
+pf = [r for r in dens if r["series"] == "PF" and r["t"] == dens[0]["t"]]
+width = float(pf[1]["x"]) - float(pf[0]["x"])
+assert abs(sum(float(r["density"]) for r in pf) * width - 1) < 0.01, "PF histogram does not integrate to ~1"
+assert "rmse_ref" in open(os.path.join(d, "report.md")).read()
+PY
+echo "ok: compare artefacts"
+
+# PF and EXACT (the grid filter on the sine model) side by side: EXACT is scored against the particle mean.
+run_kushner "$work/e" filter --model sine --filters QLF,PF,EXACT --members 8 --particles 2048 --T 0.5 --dt 1e-2 \
+  --quiet --out "$work/e1"
+[ "$rc" -eq 0 ] || fail "filter with PF,EXACT failed: $(cat "$work/e.err")"
+python3 - "$work/e1/summary.json" <<'PY' || fail "EXACT not scored against PF"
+import json, sys
+s = json.load(open(sys.argv[1]))
+f = s["filters"]
+assert s["filter_order"] == ["QLF", "PF", "EXACT"], s["filter_order"]
+assert f["EXACT"]["estimator"]["kind"] == "grid", f["EXACT"]
+# The grid filter and the particle filter approximate the same conditional mean: their distance is the
+# particle filter's own Monte Carlo error (a few hundredths at 2048 particles), far below the state's spread.
+assert f["EXACT"]["rmse_ref"] < 0.05, f["EXACT"]
+assert abs(f["EXACT"]["rmse_truth"] - f["PF"]["rmse_truth"]) < 0.05, (f["EXACT"], f["PF"])
+PY
+echo "ok: PF and EXACT"
+
+expect_refused() {  # expect_refused "message fragment" args...: one line, exit 2, nothing written
+  local expected=$1; shift
+  run_kushner "$work/r" "$@" --out "$work/refused"
+  [ "$rc" -eq 2 ] || fail "exit $rc (want 2) for: $*; stderr: $(cat "$work/r.err")"
+  [ "$(wc -l <"$work/r.err")" -eq 1 ] || fail "stderr is not one line for: $*: $(cat "$work/r.err")"
+  grep -qF -- "$expected" "$work/r.err" || fail "message lacks '$expected' for: $*: $(cat "$work/r.err")"
+  [ ! -e "$work/refused" ] || fail "a refused run created its output directory: $*"
+  echo "ok: $(cat "$work/r.err")"
+}
+expect_refused "--particles: must be at least 1 (got 0)" compare --particles 0
+expect_refused "--resample: unknown scheme 'best'" compare --resample best
+expect_refused "--ess-threshold: must be in [0, 1] (got 1.5)" compare --ess-threshold 1.5
+expect_refused "--trajectory-members: member 99 is not in 0 .. 9" compare --members 10 --trajectory-members 99
+expect_refused "--density-times: 20 is not in [0, T = 10]" compare --density-times 20
+expect_refused "filter PF does not support model 'terpolymer' (state dimension above 4)" filter --model terpolymer --filters PF
+expect_refused "filter EXACT (grid filter): prior_cov: not positive definite" filter --model car --filters EXACT
+expect_refused "filter EXACT does not support model 'terpolymer'" filter --model terpolymer --filters EXACT
+expect_refused "unknown filter 'PFF'" compare --filters QLF,PFF
+
+# A refused run leaves an earlier run's results as they were.
+before=$(md5sum "$work/c1/summary.json")
+run_kushner "$work/r" compare --particles 0 --out "$work/c1"
+[ "$rc" -eq 2 ] && [ "$(md5sum "$work/c1/summary.json")" = "$before" ] || fail "a refused run touched earlier results"
+echo "ok: earlier results untouched"
