@@ -3,9 +3,35 @@
 #include "drivers/commands.hpp"
 #include "models/registry.hpp"
 
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+
 namespace kushner {
 
 namespace {
+
+/// The metrics table on stdout: what a person running `compare` wants to see first.
+void print_summary(const nlohmann::json& summary, const std::string& out) {
+  const nlohmann::json& filters = summary["filters"];
+  auto number = [](const nlohmann::json& j, const char* key) {
+    return j.contains(key) && j[key].is_number() ? j[key].get<double>() : std::nan("");
+  };
+  std::printf("%-7s %22s %22s %16s %9s\n", "filter", "rmse_ref", "rmse_truth", "nees", "diverged");
+  for (const auto& name : summary["filter_order"]) {
+    const nlohmann::json& f = filters[name.get<std::string>()];
+    char ref[32] = "           (reference)";
+    if (f.contains("rmse_ref"))
+      std::snprintf(ref, sizeof ref, "%11.4g +- %-7.2g", number(f, "rmse_ref"), number(f, "rmse_ref_se"));
+    std::printf("%-7s %22s %11.4g +- %-7.2g %7.3g +- %-6.2g %9ld\n", name.get<std::string>().c_str(), ref,
+                number(f, "rmse_truth"), number(f, "rmse_truth_se"), number(f, "nees"), number(f, "nees_se"),
+                f["diverged"].get<long>());
+  }
+  if (summary.contains("plots_error")) std::fprintf(stderr, "kushner: warning: %s\n",
+                                                    summary["plots_error"].get<std::string>().c_str());
+  std::printf("written to %s/ (%s)\n", out.c_str(),
+              summary.value("plots", false) ? "report.md, plots, CSV, JSON" : "CSV, JSON");
+}
 
 int run_estimation(const CompareOptions& options, const RunContext& context, const char* command) {
   validate_run_options(options.run);
@@ -20,7 +46,8 @@ int run_estimation(const CompareOptions& options, const RunContext& context, con
       check_compare_options<Model>(model, options, config);  // before anything is written
       const OutputDirectory out(options.run.out, "--out");
       KokkosSession kokkos;
-      run_compare_command(model, options, config, grid, context, out);
+      const nlohmann::json summary = run_compare_command(model, options, config, grid, context, out);
+      if (options.plots && !options.run.quiet) print_summary(summary, options.run.out);
     }
   });
   return 0;
