@@ -6,26 +6,6 @@
 
 namespace kushner {
 
-/// Lower-triangular L with L L^T = A. Returns false (and leaves L partial) when a pivot is not positive
-/// or not finite: A is then not (numerically) positive definite.
-template <int N>
-KOKKOS_INLINE_FUNCTION bool cholesky(const Mat<N, N>& A, Mat<N, N>& L) {
-  L = Mat<N, N>::zero();
-  for (int j = 0; j < N; ++j) {
-    double d = A(j, j);
-    for (int k = 0; k < j; ++k) d -= L(j, k) * L(j, k);
-    if (!(d > 0.0) || !math::is_finite(d)) return false;
-    const double ljj = math::sqrt(d);
-    L(j, j) = ljj;
-    for (int i = j + 1; i < N; ++i) {
-      double s = A(i, j);
-      for (int k = 0; k < j; ++k) s -= L(i, k) * L(j, k);
-      L(i, j) = s / ljj;
-    }
-  }
-  return true;
-}
-
 /// How a symmetric matrix factored by semidefinite_cholesky turned out.
 enum class Definiteness { positive_definite, singular, indefinite };
 
@@ -57,6 +37,14 @@ KOKKOS_INLINE_FUNCTION Definiteness semidefinite_cholesky(const Mat<N, N>& A, Ma
     }
   }
   return result;
+}
+
+/// Lower-triangular L with L L^T = A. Returns false (and leaves L partial) when a pivot is not positive
+/// or not finite: A is then not (numerically) positive definite. The semidefinite factorization with a zero
+/// tolerance, so both give the same L bit for bit where A is positive definite.
+template <int N>
+KOKKOS_INLINE_FUNCTION bool cholesky(const Mat<N, N>& A, Mat<N, N>& L) {
+  return semidefinite_cholesky(A, L, 0.0) == Definiteness::positive_definite;
 }
 
 /// Solves L L^T x = b for x, given the Cholesky factor L.
