@@ -12,7 +12,7 @@ namespace kushner {
 constexpr int max_scan_blocks = 4096;
 
 /// Entries a thread loads at once in the scan's sequential loops.
-constexpr int scan_batch = 8;
+constexpr int scan_batch = 16;
 
 /// Entries per block: 256, or more when the column has more than 256 * max_scan_blocks entries.
 KOKKOS_INLINE_FUNCTION constexpr int scan_block_size(int n) {

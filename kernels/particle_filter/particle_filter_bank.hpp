@@ -78,7 +78,8 @@ class ParticleFilterBank {
     KUSHNER_REQUIRE(use_team_ || host_memory, "the host block kernel needs host memory");
     team_size_ = options.team_size > 0 ? options.team_size : (host_memory ? 1 : device_particle_team);
     const int per_thread = options.particles_per_thread > 0 ? options.particles_per_thread : device_particles_per_thread;
-    block_size_ = use_team_ ? (host_memory ? device_particles_per_thread * device_particle_team : team_size_ * per_thread)
+    // The team kernel on the host (tests) keeps 1024-particle chunks, so small tests still merge several.
+    block_size_ = use_team_ ? (host_memory ? device_particle_batch * device_particle_team : team_size_ * per_thread)
                             : host_particle_block;
     num_blocks_ = (num_particles + block_size_ - 1) / block_size_;
 
@@ -181,9 +182,9 @@ class ParticleFilterBank {
   void run_step_kernels(const ParticleStepData<Model, MemSpace>& d) {
     constexpr int n = state_dim;
     if (use_team_) {
-      // Batches of 4 particles per thread, as many as the block holds (per_thread 8: two batches). Larger
+      // Batches of 4 particles per thread, as many as the block holds (per_thread 16: four batches). Larger
       // batches need more registers: 8 and 16 ran slower on an H100.
-      run_team_kernel<device_particles_per_thread>(d);
+      run_team_kernel<device_particle_batch>(d);
     } else {
       run_host_block_kernel(d);
     }

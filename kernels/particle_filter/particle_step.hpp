@@ -37,10 +37,13 @@ namespace kushner {
 /// Particles per block of the host kernel: its arrays stay in L1, and the blocks of all members are the
 /// units of parallel work.
 constexpr int host_particle_block = 256;
-/// GPU teams: 256 threads, each taking 4 particles of the team's chunk (benchmarked against 8 and 16 by
-/// perf/bench_particle_filter.cpp's per_thread argument).
+/// GPU teams: 256 threads, each taking 16 particles of the team's chunk in batches of 4 (the loads of a batch
+/// in flight together). Measured on an H100 at M = 1000, N = 65536 (perf/bench_particle_filter.cpp's
+/// per_thread argument): 4.44e10 particle-steps/s with 4 per thread, 4.71e10 with 8, 4.84e10 with 16; batches
+/// of 8 or 16 need more registers and ran slower.
 constexpr int device_particle_team = 256;
-constexpr int device_particles_per_thread = 4;
+constexpr int device_particles_per_thread = 16;
+constexpr int device_particle_batch = 4;
 /// Launch bound of the team kernel: teams resident per multiprocessor (4 caps it at 64 registers; on an H100,
 /// 4 teams of 64 registers ran 18% faster than 2 of 106, bench_particle_filter, M = 1000, N = 65536).
 constexpr int device_particle_teams_per_sm = 4;
@@ -241,7 +244,7 @@ KOKKOS_INLINE_FUNCTION double log_weight_bound(const ParticleStepData<Model, Mem
 /// from the observation, an extreme dy), the sums could under- or overflow: the team then sums its particles
 /// again, from the values it just stored, with s = its largest l. Every sum has an order fixed by the team
 /// size, so a seed gives the same bits on every run.
-template <class Model, class ExecSpace, int P = device_particles_per_thread>
+template <class Model, class ExecSpace, int P = device_particle_batch>
 struct ParticleTeamStep {
   using MemSpace = typename ExecSpace::memory_space;
   using Team = typename Kokkos::TeamPolicy<ExecSpace>::member_type;
