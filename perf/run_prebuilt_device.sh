@@ -20,18 +20,6 @@ echo "run_gpu_benchmarks rc $?"
 cat $O/steps.log
 grep -h "Duration\|Issue Slots Busy\|Registers Per\|Achieved Occupancy\|DRAM Throughput\|Executed Instructions  \|FP64 instructions\|cuda_parallel_launch" $O/ncu_*.log 2>/dev/null | cut -c1-150
 cuobjdump --list-elf build-cuda/perf/bench_particle_filter 2>&1 | head -4
-if [ -n "${PF_SASS:-}" ]; then
-  cuobjdump -sass -fun '.*ParticleTeamStep.*' build-cuda/perf/bench_particle_filter > $O/team_sass.txt 2>&1
-  python3 - $O/team_sass.txt <<'PY'
-import re,sys,collections
-c=collections.Counter(); tot=0
-for line in open(sys.argv[1]):
-    m=re.match(r'\s*/\*[0-9a-f]{4,}\*/\s+(@!?U?P\w+\s+)?([A-Z][A-Z0-9_]*)(\.[\w\.]+)?', line)
-    if m: c[m.group(2)]+=1; tot+=1
-print('SASS static instructions (all team-step kernels in the binary):', tot)
-print(' '.join(f'{k}:{v}' for k,v in c.most_common(40)))
-PY
-fi
 cat $O/summary.txt
 tar czf $final/all.tgz -C $O . ; cp $O/summary.txt $final/ 2>/dev/null
 date -u +%T
