@@ -30,6 +30,7 @@ void BM_ParticleFilterStep(benchmark::State& state) {
   const Model model;
   TruthBank<Space, Model> truth(space, model, members, 42);
   ParticleFilterOptions options;
+  if (state.range(3) == 0) options.ess_threshold = 0.0;  // never resample: the cost of the other kernels
   if (state.range(2) > 0) options.particles_per_thread = static_cast<int>(state.range(2));
   ParticleFilterBank<Space, Model> pf(space, model, members, particles, 43, options);
   long k = 0;
@@ -87,12 +88,14 @@ void BM_StreamCopy(benchmark::State& state) {
 }
 
 // M x N: the CPU target (100 x 4096), then M.N = 1e6 .. 1e9; sizes past 1e7 only where a GPU runs them.
-// The third argument (GPU team kernel only) is particles per thread; 0 = the default.
+// The third argument (GPU team kernel only) is particles per thread, 0 = the default; the fourth, 0, turns
+// resampling off (ESS threshold 0), which shows what resampling costs.
 BENCHMARK_TEMPLATE(BM_ParticleFilterStep, SineModel)->Apply([](benchmark::internal::Benchmark* b) {
-  b->ArgNames({"members", "particles", "per_thread"})->Args({100, 4096, 0})->Args({1000, 1024, 0})->Args({1000, 16384, 0});
+  b->ArgNames({"members", "particles", "per_thread", "resample"});
+  b->Args({100, 4096, 0, 1})->Args({1000, 1024, 0, 1})->Args({1000, 16384, 0, 1});
 #if defined(KOKKOS_ENABLE_CUDA)
-  b->Args({1000, 65536, 0})->Args({10000, 65536, 0})->Args({15259, 65536, 0});
-  b->Args({1000, 65536, 8})->Args({1000, 65536, 16});
+  b->Args({1000, 65536, 0, 1})->Args({10000, 65536, 0, 1})->Args({15259, 65536, 0, 1});
+  b->Args({1000, 65536, 8, 1})->Args({1000, 65536, 16, 1})->Args({1000, 65536, 0, 0});
 #endif
 })->UseManualTime();
 BENCHMARK_TEMPLATE(BM_StreamCopy, SineModel)->Apply([](benchmark::internal::Benchmark* b) {

@@ -55,7 +55,7 @@ def report_sizes(out, source):
         res = med(rows, "resamples_per_member_step")
         print(f"PF step {size}: median {rate:.3g} particle-steps/s (n={n}, spread {lo:.3g}..{hi:.3g}); "
               f"32 B/particle-step = {gbs:.0f} GB/s{frac}; resamples/member-step {res[0]:.2g}")
-        if size == "members:1000/particles:65536/per_thread:0":
+        if size == "members:1000/particles:65536/per_thread:0/resample:1":
             target = rate
     return target
 

@@ -12,6 +12,10 @@
 #   compare  M = 1000, N = 65536: kushner's PF step and BM_StreamCopy, then PyTorch eager and torch.compile,
 #            in the same call (the side-by-side ratio)
 #   sizes    every size M.N = 4e5 .. 1e9 (5 repetitions) and Kokkos vs Thrust resampling
+#   profile  Nsight Compute (ncu, where installed) on one launch of each step kernel at M = 1000, N = 65536:
+#            duration, throughput, occupancy, issue-slot use (ncu locks the clocks to base: durations are
+#            longer than in the benchmark)
+# The phases other than build only need build-cuda/: binaries built elsewhere (same CUDA major version) run.
 # Where one call has a time limit, run the phases in separate calls, e.g.
 #   KUSHNER_PHASES=build ...; KUSHNER_PHASES=test ...; KUSHNER_PHASES=compare ...; KUSHNER_PHASES=sizes ...
 # Roughly: build 3-5 min at -j16, test 2-3 min, compare 3-4 min (torch.compile compiles first), sizes 3 min.
@@ -56,7 +60,7 @@ if want test; then
 fi
 
 if want compare; then
-  run bench_compare "$build/perf/bench_particle_filter" --benchmark_filter='members:1000/particles:65536/(per_thread:0/)?manual' \
+  run bench_compare "$build/perf/bench_particle_filter" --benchmark_filter='members:1000/particles:65536/(per_thread:0/resample:1/)?manual' \
     --benchmark_repetitions="$reps" --benchmark_enable_random_interleaving=true \
     --benchmark_out="$out/bench_compare.json" --benchmark_out_format=json
   run torch_eager python3 "$here/perf/pf_torch.py" --mode eager --members 1000 --particles 65536 --repetitions "$reps"
@@ -69,6 +73,21 @@ if want sizes; then
     --benchmark_out="$out/bench_particle_filter.json" --benchmark_out_format=json
   run bench_resampling "$build/perf/bench_resampling" --benchmark_repetitions=5 \
     --benchmark_out="$out/bench_resampling.json" --benchmark_out_format=json
+fi
+
+if want profile; then
+  if command -v ncu > /dev/null; then
+    filter='--benchmark_filter=BM_ParticleFilterStep.*members:1000/particles:65536/per_thread:0/resample:1/'
+    run ncu_team_step ncu --kernel-name-base mangled --kernel-name regex:ParticleTeamStep --launch-skip 250 \
+      --launch-count 1 --section SpeedOfLight --section ComputeWorkloadAnalysis --section Occupancy \
+      --section LaunchStats --section WarpStateStats --section InstructionStats \
+      "$build/perf/bench_particle_filter" "$filter" --benchmark_repetitions=1 --benchmark_min_time=0.01
+    run ncu_posterior_resample ncu --kernel-name-base mangled --kernel-name regex:'ParticlePosterior|ParticleResampleStep' \
+      --launch-skip 600 --launch-count 6 --section SpeedOfLight \
+      "$build/perf/bench_particle_filter" "$filter" --benchmark_repetitions=1 --benchmark_min_time=0.01
+  else
+    step "profile: no ncu on this machine"
+  fi
 fi
 
 python3 "$here/perf/gpu_summary.py" "$out" | tee "$out/summary.txt"

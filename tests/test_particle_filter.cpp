@@ -170,6 +170,37 @@ TEST(ParticleFilterBank, TeamKernelAgreesWithHostBlockKernel) {
   }
 }
 
+TEST(ParticleFilterBank, TeamKernelResumsWhenTheWeightBoundIsFarOff) {
+  // The team kernel sums exp(l - s) with s = dy^T V^-1 dy / (2 dt), the largest log-weight any particle could
+  // get. A large dy puts s hundreds of nats above every particle's l: the kernel must notice and sum again
+  // relative to the largest l (member 1), and give what the host kernel (exact block maxima) gives.
+  SineModel model;
+  const int members = 3, particles = 3000;
+  ParticleFilterOptions block, team;
+  block.kernel = ParticleKernel::host_block;
+  block.ess_threshold = team.ess_threshold = 0.0;  // keep the weights: the next steps start from them
+  team.kernel = ParticleKernel::team;
+  ParticleFilterBank<Host, SineModel> pb(Host(), model, members, particles, seed, block);
+  ParticleFilterBank<Host, SineModel> pt(Host(), model, members, particles, seed, team);
+  BankVector<Kokkos::HostSpace> dy("dy", members, 1);
+  for (int k = 0; k < 3; ++k) {
+    dy(0, 0) = 0.01;
+    dy(1, 0) = k == 1 ? 30.0 : 0.01;  // s - max l ~ 0.5 * 30^2 / 0.01 at step 1
+    dy(2, 0) = -0.02;
+    pb.step(k, 0.01, dy);
+    pt.step(k, 0.01, dy);
+  }
+  Host().fence();
+  for (int m = 0; m < members; ++m) {
+    ASSERT_EQ(pt.status()(m), Status::ok) << m;
+    EXPECT_NEAR(pt.posterior_mean()(m, 0), pb.posterior_mean()(m, 0), 1e-12 * (1 + std::abs(pb.posterior_mean()(m, 0)))) << m;
+    EXPECT_NEAR(pt.posterior_covariance()(m, 0), pb.posterior_covariance()(m, 0), 1e-12 * pb.posterior_covariance()(m, 0)) << m;
+    EXPECT_NEAR(pt.effective_sample_size()(m), pb.effective_sample_size()(m), 1e-10 * pb.effective_sample_size()(m)) << m;
+    EXPECT_NEAR(pt.log_normalizer()(m), pb.log_normalizer()(m), 1e-12 * (1 + std::abs(pb.log_normalizer()(m)))) << m;
+  }
+  EXPECT_LT(pt.effective_sample_size()(1), 0.1 * particles);  // the outlying dy did concentrate the weights
+}
+
 TEST(ParticleFilterBank, RejectsBadSizesAndThresholds) {
   SineModel model;
   EXPECT_THROW((ParticleFilterBank<Host, SineModel>(Host(), model, 2, 0, seed)), InputError);

@@ -11,6 +11,9 @@ namespace kushner {
 /// At most this many blocks per column: their sums live in team scratch memory (32 KiB of doubles).
 constexpr int max_scan_blocks = 4096;
 
+/// Entries a thread loads at once in the scan's sequential loops.
+constexpr int scan_batch = 16;
+
 /// Entries per block: 256, or more when the column has more than 256 * max_scan_blocks entries.
 KOKKOS_INLINE_FUNCTION constexpr int scan_block_size(int n) {
   const int needed = (n + max_scan_blocks - 1) / max_scan_blocks;
@@ -28,10 +31,18 @@ KOKKOS_INLINE_FUNCTION typename View::non_const_value_type blocked_inclusive_sca
                                                                                   const Scratch& block_sums) {
   using Value = typename View::non_const_value_type;
   const int block = scan_block_size(n), num_blocks = scan_num_blocks(n);
+  // Both passes read `scan_batch` entries before using them: the same sequential sums, but a GPU thread
+  // waits for memory once per batch instead of once per entry (the second pass stores into the column it
+  // reads, so the compiler cannot move loads ahead by itself).
   Kokkos::parallel_for(Kokkos::TeamThreadRange(team, num_blocks), [&](const int b) {
     const int end = (b + 1) * block < n ? (b + 1) * block : n;
     Value sum = 0;
-    for (int j = b * block; j < end; ++j) sum += values(j, member);
+    for (int j0 = b * block; j0 < end; j0 += scan_batch) {
+      Value v[scan_batch];
+      for (int k = 0; k < scan_batch; ++k) v[k] = j0 + k < end ? values(j0 + k, member) : Value(0);
+      for (int k = 0; k < scan_batch; ++k)
+        if (j0 + k < end) sum += v[k];
+    }
     block_sums(b) = static_cast<double>(sum);
   });
   team.team_barrier();
@@ -47,9 +58,14 @@ KOKKOS_INLINE_FUNCTION typename View::non_const_value_type blocked_inclusive_sca
   Kokkos::parallel_for(Kokkos::TeamThreadRange(team, num_blocks), [&](const int b) {
     const int end = (b + 1) * block < n ? (b + 1) * block : n;
     Value running = static_cast<Value>(block_sums(b));
-    for (int j = b * block; j < end; ++j) {
-      running += values(j, member);
-      values(j, member) = running;
+    for (int j0 = b * block; j0 < end; j0 += scan_batch) {
+      Value v[scan_batch];
+      for (int k = 0; k < scan_batch; ++k) v[k] = j0 + k < end ? values(j0 + k, member) : Value(0);
+      for (int k = 0; k < scan_batch; ++k)
+        if (j0 + k < end) {
+          running += v[k];
+          values(j0 + k, member) = running;
+        }
     }
   });
   team.team_barrier();

@@ -78,7 +78,8 @@ class ParticleFilterBank {
     KUSHNER_REQUIRE(use_team_ || host_memory, "the host block kernel needs host memory");
     team_size_ = options.team_size > 0 ? options.team_size : (host_memory ? 1 : device_particle_team);
     const int per_thread = options.particles_per_thread > 0 ? options.particles_per_thread : device_particles_per_thread;
-    block_size_ = use_team_ ? (host_memory ? device_particles_per_thread * device_particle_team : team_size_ * per_thread)
+    // The team kernel on the host (tests) keeps 1024-particle chunks, so small tests still merge several.
+    block_size_ = use_team_ ? (host_memory ? device_particle_batch * device_particle_team : team_size_ * per_thread)
                             : host_particle_block;
     num_blocks_ = (num_particles + block_size_ - 1) / block_size_;
 
@@ -181,10 +182,9 @@ class ParticleFilterBank {
   void run_step_kernels(const ParticleStepData<Model, MemSpace>& d) {
     constexpr int n = state_dim;
     if (use_team_) {
-      using Kernel = ParticleTeamStep<Model, ExecSpace>;
-      Kokkos::TeamPolicy<ExecSpace> policy(space_, num_blocks_ * num_members_, team_size_);
-      policy.set_scratch_size(0, Kokkos::PerTeam(Kernel::scratch_bytes(team_size_)));
-      Kokkos::parallel_for("kushner::particle_team_step", policy, Kernel{d, num_blocks_});
+      // Batches of 4 particles per thread, as many as the block holds (per_thread 16: four batches). Larger
+      // batches need more registers: 8 and 16 ran slower on an H100.
+      run_team_kernel<device_particle_batch>(d);
     } else {
       run_host_block_kernel(d);
     }
@@ -193,11 +193,37 @@ class ParticleFilterBank {
                                                         log_normalizer_, resample_, resample_count_, status_,
                                                         options_.ess_threshold * num_particles_});
     if (d.initialize) return;
+    if constexpr (!std::is_same<MemSpace, Kokkos::HostSpace>::value) {
+      // A team per member, most of which return at once; the few that resample are latency-bound, so they
+      // get big teams (the launch bound keeps the kernel within the registers 1024 threads have).
+      const int team = options_.team_size > 0 ? options_.team_size : device_resample_team;
+      Kokkos::TeamPolicy<ExecSpace, Kokkos::LaunchBounds<device_resample_team, 1>> policy(space_, num_members_, team);
+      policy.set_scratch_size(0, Kokkos::PerTeam(sizeof(double) * scan_num_blocks(num_particles_)));
+      Kokkos::parallel_for("kushner::particle_resample", policy,
+                           ParticleResampleStep<n, ExecSpace>{x_, x_scratch_, workspace_, log_normalizer_, resample_,
+                                                              num_particles_, options_.scheme, seed_, d.step});
+      return;
+    }
     Kokkos::TeamPolicy<ExecSpace> policy(space_, num_members_, team_size_);
     policy.set_scratch_size(0, Kokkos::PerTeam(sizeof(double) * scan_num_blocks(num_particles_)));
     Kokkos::parallel_for("kushner::particle_resample", policy,
                          ParticleResampleStep<n, ExecSpace>{x_, x_scratch_, workspace_, log_normalizer_, resample_,
                                                             num_particles_, options_.scheme, seed_, d.step});
+  }
+
+  template <int Batch>
+  void run_team_kernel(const ParticleStepData<Model, MemSpace>& d) {
+    using Kernel = ParticleTeamStep<Model, ExecSpace, Batch>;
+    if (team_size_ == device_particle_team) {  // measured best on an H100: 4 teams (64 registers) per SM
+      Kokkos::TeamPolicy<ExecSpace, Kokkos::LaunchBounds<device_particle_team, device_particle_teams_per_sm>> policy(
+          space_, num_blocks_ * num_members_, team_size_);
+      policy.set_scratch_size(0, Kokkos::PerTeam(Kernel::scratch_bytes(team_size_)));
+      Kokkos::parallel_for("kushner::particle_team_step", policy, Kernel{d, num_blocks_});
+      return;
+    }
+    Kokkos::TeamPolicy<ExecSpace> policy(space_, num_blocks_ * num_members_, team_size_);
+    policy.set_scratch_size(0, Kokkos::PerTeam(Kernel::scratch_bytes(team_size_)));
+    Kokkos::parallel_for("kushner::particle_team_step", policy, Kernel{d, num_blocks_});
   }
 
   void run_host_block_kernel(const ParticleStepData<Model, MemSpace>& d) {

@@ -29,8 +29,17 @@ struct ParticlePosterior {
       ess(member) = 0.0;
       return;
     }
+    // Block order, as always; the loads of a batch of partials are issued before the merges (a GPU thread
+    // otherwise waits for memory once per block).
+    constexpr int batch = WeightedMoments<N>::size <= 8 ? 8 : (WeightedMoments<N>::size <= 16 ? 4 : 1);
     WeightedMoments<N> w = WeightedMoments<N>::load(partials, 0, member);
-    for (int b = 1; b < num_blocks; ++b) w.merge(WeightedMoments<N>::load(partials, b, member));
+    for (int b0 = 1; b0 < num_blocks; b0 += batch) {
+      WeightedMoments<N> p[batch];
+      for (int k = 0; k < batch; ++k)
+        if (b0 + k < num_blocks) p[k] = WeightedMoments<N>::load(partials, b0 + k, member);
+      for (int k = 0; k < batch; ++k)
+        if (b0 + k < num_blocks) w.merge(p[k]);
+    }
     bool finite = w.sum_weight > 0.0 && math::is_finite(w.sum_weight) && math::is_finite(w.max_log_weight);
     const double inverse = 1.0 / w.sum_weight;
     Vec<N> mean_dx = w.sum_dx * inverse;

@@ -31,21 +31,40 @@ struct ParticleResampleStep {
     if (resample(member) == 0) return;
     const int n = num_particles;
     const double log_total = log_normalizer(member);
-    Kokkos::parallel_for(Kokkos::TeamThreadRange(team, n), [&](const int j) {
-      ws.cumulative(j, member) = math::exp(ws.cumulative(j, member) - log_total);  // exp(-inf) = 0: dead particles
-    });
+    // Each thread handles `batch` particles at a time, strided by the team size, with every load of a batch
+    // issued before its stores: these loops are latency-bound on a GPU (one team per resampled member).
+    constexpr int batch = 8;
+    const int threads = team.team_size(), rank = team.team_rank();
+    for (int j0 = rank; j0 < n; j0 += batch * threads) {
+      double l[batch];
+      for (int k = 0; k < batch; ++k) l[k] = j0 + k * threads < n ? ws.cumulative(j0 + k * threads, member) : 0.0;
+      for (int k = 0; k < batch; ++k)  // exp(-inf) = 0: dead particles
+        if (j0 + k * threads < n) ws.cumulative(j0 + k * threads, member) = math::exp(l[k] - log_total);
+    }
     team.team_barrier();
     const Scratch block_sums(team.team_scratch(0), scan_num_blocks(n));
     resample_member(team, ws, member, n, scheme, seed, step, block_sums);
-    Kokkos::parallel_for(Kokkos::TeamThreadRange(team, n), [&](const int s) {
-      const int a = ws.ancestors(s, member);
-      for (int i = 0; i < N; ++i) x_scratch(s, member, i) = x(a, member, i);
-    });
+    for (int s0 = rank; s0 < n; s0 += batch * threads) {
+      int a[batch];
+      double v[batch][N];
+      for (int k = 0; k < batch; ++k) a[k] = s0 + k * threads < n ? ws.ancestors(s0 + k * threads, member) : 0;
+      for (int k = 0; k < batch; ++k)
+        for (int i = 0; i < N; ++i) v[k][i] = s0 + k * threads < n ? x(a[k], member, i) : 0.0;
+      for (int k = 0; k < batch; ++k)
+        if (s0 + k * threads < n)
+          for (int i = 0; i < N; ++i) x_scratch(s0 + k * threads, member, i) = v[k][i];
+    }
     team.team_barrier();
-    Kokkos::parallel_for(Kokkos::TeamThreadRange(team, n), [&](const int s) {
-      for (int i = 0; i < N; ++i) x(s, member, i) = x_scratch(s, member, i);
-      ws.cumulative(s, member) = 0.0;
-    });
+    for (int s0 = rank; s0 < n; s0 += batch * threads) {
+      double v[batch][N];
+      for (int k = 0; k < batch; ++k)
+        for (int i = 0; i < N; ++i) v[k][i] = s0 + k * threads < n ? x_scratch(s0 + k * threads, member, i) : 0.0;
+      for (int k = 0; k < batch; ++k)
+        if (s0 + k * threads < n) {
+          for (int i = 0; i < N; ++i) x(s0 + k * threads, member, i) = v[k][i];
+          ws.cumulative(s0 + k * threads, member) = 0.0;
+        }
+    }
     Kokkos::single(Kokkos::PerTeam(team), [&]() { log_normalizer(member) = math::log(static_cast<double>(n)); });
   }
 };

@@ -19,7 +19,8 @@ struct WeightedMoments {
   static constexpr int packed = packed_size(N);       // entries of a packed N x N symmetric matrix
   static constexpr int size = 3 + N + packed;         // doubles in a stored partial
 
-  double max_log_weight;  // m; -inf for an empty set (or one whose weights are all zero)
+  double max_log_weight;  // m: the largest log-weight of the set, or any shift near it (the GPU team kernel
+                          // uses one per member and step); -inf for an empty set (or one whose weights are all zero)
   double sum_weight;      // sum e^{l - m}
   double sum_weight_sq;   // sum e^{2 (l - m)}
   Vec<N> sum_dx;          // sum e^{l - m} (x - ref)
@@ -49,7 +50,9 @@ struct WeightedMoments {
   /// This set followed by `other`; the order matters in the last bits only.
   KOKKOS_INLINE_FUNCTION void merge(const WeightedMoments& other) {
     if (!(other.max_log_weight > -positive_infinity())) return;
-    if (other.max_log_weight > max_log_weight) {
+    if (other.max_log_weight == max_log_weight) {  // the GPU's blocks share one shift: no exp (exp(0) = 1 exactly)
+      add_scaled(other, 1.0);
+    } else if (other.max_log_weight > max_log_weight) {
       scale(math::exp(max_log_weight - other.max_log_weight));
       max_log_weight = other.max_log_weight;
       add_scaled(other, 1.0);
@@ -57,6 +60,9 @@ struct WeightedMoments {
       add_scaled(other, math::exp(other.max_log_weight - max_log_weight));
     }
   }
+
+  /// Adds one particle of weight e = exp(l - max_log_weight) > 0 (the caller took the exp with a fixed shift).
+  KOKKOS_INLINE_FUNCTION void add_weight(double e, const Vec<N>& dx) { accumulate(e, dx); }
 
   KOKKOS_INLINE_FUNCTION void store(double* out) const {
     out[0] = max_log_weight;
