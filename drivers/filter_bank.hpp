@@ -11,6 +11,7 @@
 #include "kernels/filters/filter_bank_step.hpp"
 #include "kernels/filters/filter_list.hpp"
 #include "kernels/filters/filter_metrics.hpp"
+#include "kernels/for_each_member.hpp"
 
 #include <Kokkos_Core.hpp>
 
@@ -95,7 +96,7 @@ class FilterBank {
       });
       KUSHNER_REQUIRE(found, "filter '" << name << "' is not supported by model " << Model::name);
     }
-    Kokkos::parallel_for("kushner::filter_bank_initial_score", Kokkos::RangePolicy<ExecSpace>(space_, 0, members_),
+    parallel_for_members("kushner::filter_bank_initial_score", space_, members_,
                          typename K::Initial{truths_.state(), slots_});
   }
 
@@ -126,7 +127,7 @@ class FilterBank {
     typename K::Step kernel{EulerMaruyamaTruthStep<Model, MemSpace>{truth_model_, truths_.state(),
                                                                     truths_.observations(), k * dt, dt, seed_, step},
                             filter_model_, truth_status_, slots_, record};
-    Kokkos::parallel_for("kushner::filter_bank_step", Kokkos::RangePolicy<ExecSpace>(space_, 0, members_), kernel);
+    parallel_for_members("kushner::filter_bank_step", space_, members_, kernel);
     bool reference_stepped = false;
     for (auto& e : estimators_) {
       e.estimator->advance(k, k * dt, dt, truths_.observations());
@@ -200,7 +201,7 @@ class FilterBank {
     FilterScores s;
     with_slot(name, [&](const auto& slot) {
       BankVector<MemSpace> per_member("kushner::member_scores", members_, num_member_score_columns);
-      Kokkos::parallel_for("kushner::member_scores", Kokkos::RangePolicy<ExecSpace>(space_, 0, members_),
+      parallel_for_members("kushner::member_scores", space_, members_,
                            MemberScores<MemSpace>{slot.score, slot.status, truth_status_, per_member,
                                                   static_cast<double>(points), scored_against_reference(name)});
       s.rmse_truth = root_mean(per_member, member_mean_squared_error);
@@ -262,12 +263,12 @@ class FilterBank {
     e.slot.status = e.estimator->status();
     const BankVector<MemSpace> reference =
         scored_against_reference(e.name) ? reference_->mean() : BankVector<MemSpace>();
-    Kokkos::parallel_for("kushner::estimator_score", Kokkos::RangePolicy<ExecSpace>(space_, 0, members_),
+    parallel_for_members("kushner::estimator_score", space_, members_,
                          EstimatorScore<n, MemSpace>{e.slot, truths_.state(), reference, truth_status_, record});
   }
 
   void score_reference(bool record) {
-    Kokkos::parallel_for("kushner::filter_bank_reference_score", Kokkos::RangePolicy<ExecSpace>(space_, 0, members_),
+    parallel_for_members("kushner::filter_bank_reference_score", space_, members_,
                          typename K::Reference{reference_->mean(), truth_status_, slots_, record});
   }
 

@@ -6,6 +6,7 @@
 // filters closer to the particle mean than its root mean, the reference's noise floor. Reduced on the host
 // in member order, so the figures are the same on any number of threads.
 #include "drivers/reference_estimator.hpp"
+#include "kernels/for_each_member.hpp"
 #include "kernels/particle_filter/particle_filter_bank.hpp"
 
 #include <Kokkos_Core.hpp>
@@ -60,9 +61,9 @@ class ParticleReference final : public ReferenceEstimator<typename ExecSpace::me
   std::string name() const override { return "PF"; }
   void advance(long k, double, double dt, const BankVector<MemSpace>& dy) override {
     pf_.step(k, dt, dy);
-    Kokkos::parallel_for("kushner::accumulate_ess", Kokkos::RangePolicy<ExecSpace>(space_, 0, pf_.num_members()),
-                         AccumulateEss<Model::state_dim, MemSpace>{pf_.effective_sample_size(),
-                                                                   pf_.posterior_covariance(), sums_});
+    parallel_for_members(
+        "kushner::accumulate_ess", space_, pf_.num_members(),
+        AccumulateEss<Model::state_dim, MemSpace>{pf_.effective_sample_size(), pf_.posterior_covariance(), sums_});
     ++steps_;
   }
   BankVector<MemSpace> mean() const override { return pf_.posterior_mean(); }

@@ -4,6 +4,7 @@
 // take x[k+1] = F(k, x[k], u) + w[k] and produce z[k+1] = H x[k+1] + v[k+1] in the same bank.
 #include "kernels/bank.hpp"
 #include "kernels/errors.hpp"
+#include "kernels/for_each_member.hpp"
 #include "kernels/rng.hpp"
 
 #include <Kokkos_Core.hpp>
@@ -30,7 +31,7 @@ template <class ExecSpace, int N, class MemSpace>
 void initialize_gaussian(const ExecSpace& space, const BankVector<MemSpace>& x, const Vec<N>& mean,
                          const Mat<N, N>& root, RngKey key) {
   KUSHNER_REQUIRE(x.extent_int(1) == N, "x has " << x.extent(1) << " columns, expected " << N);
-  Kokkos::parallel_for("kushner::initialize_gaussian", Kokkos::RangePolicy<ExecSpace>(space, 0, x.extent(0)),
+  parallel_for_members("kushner::initialize_gaussian", space, x.extent(0),
                        GaussianInitialize<N, MemSpace>{x, mean, root, key});
 }
 
@@ -86,12 +87,11 @@ void simulate_truth_step(const ExecSpace& space, const Model& model, const BankV
                   "x has " << x.extent(1) << " columns, " << Model::name << " has state_dim " << Model::state_dim);
   KUSHNER_REQUIRE(observations.extent_int(1) == Model::obs_dim && observations.extent(0) == x.extent(0),
                   "observation bank has shape (" << observations.extent(0) << ", " << observations.extent(1) << ")");
-  const Kokkos::RangePolicy<ExecSpace> members(space, 0, x.extent(0));
   if constexpr (Model::discrete_time) {
-    Kokkos::parallel_for("kushner::discrete_truth_step", members,
+    parallel_for_members("kushner::discrete_truth_step", space, x.extent(0),
                          DiscreteTruthStep<Model, MemSpace>{model, x, observations, seed, step});
   } else {
-    Kokkos::parallel_for("kushner::euler_maruyama_truth_step", members,
+    parallel_for_members("kushner::euler_maruyama_truth_step", space, x.extent(0),
                          EulerMaruyamaTruthStep<Model, MemSpace>{model, x, observations, t, dt, seed, step});
   }
 }

@@ -15,6 +15,7 @@
 // library only.
 #include "kernels/bank.hpp"
 #include "kernels/errors.hpp"
+#include "kernels/for_each_member.hpp"
 #include "kernels/linear_algebra.hpp"
 #include "kernels/particle_filter/particle_posterior.hpp"
 #include "kernels/particle_filter/particle_resample_step.hpp"
@@ -139,7 +140,7 @@ class ParticleFilterBank {
   /// that earlier resamplings added, so it understates the error; independent seeds give the honest figure.
   BankVector<MemSpace> monte_carlo_standard_error() const {
     BankVector<MemSpace> se("kushner::particle_mc_se", num_members_, state_dim);
-    Kokkos::parallel_for("kushner::particle_mc_se", Kokkos::RangePolicy<ExecSpace>(space_, 0, num_members_),
+    parallel_for_members("kushner::particle_mc_se", space_, num_members_,
                          MonteCarloStandardError<state_dim, MemSpace>{covariance_, ess_, se});
     return se;
   }
@@ -188,10 +189,10 @@ class ParticleFilterBank {
     } else {
       run_host_block_kernel(d);
     }
-    Kokkos::parallel_for("kushner::particle_posterior", Kokkos::RangePolicy<ExecSpace>(space_, 0, num_members_),
-                         ParticlePosterior<n, MemSpace>{partials_, num_blocks_, reference_, mean_, covariance_, ess_,
-                                                        log_normalizer_, resample_, resample_count_, status_,
-                                                        options_.ess_threshold * num_particles_});
+    parallel_for_members(
+        "kushner::particle_posterior", space_, num_members_,
+        ParticlePosterior<n, MemSpace>{partials_, num_blocks_, reference_, mean_, covariance_, ess_, log_normalizer_,
+                                       resample_, resample_count_, status_, options_.ess_threshold * num_particles_});
     if (d.initialize) return;
     if constexpr (!std::is_same<MemSpace, Kokkos::HostSpace>::value) {
       // A team per member, most of which return at once; the few that resample are latency-bound, so they

@@ -9,6 +9,7 @@
 // `#pragma omp simd` loops (GCC does not vectorize a Kokkos range loop), and a team kernel for GPUs where a
 // team reduces its chunk in shared memory. Both call the same per-particle physics below.
 #include "kernels/bank.hpp"
+#include "kernels/for_each_member.hpp"
 #include "kernels/linear_algebra.hpp"
 #include "kernels/math.hpp"
 #include "kernels/particle_filter/particle_model_traits.hpp"
@@ -137,12 +138,10 @@ KOKKOS_INLINE_FUNCTION double update_particle(const ParticleStepData<Model, MemS
 }
 
 /// The host kernel's work for one block: a function of the model and the data only (not of the execution
-/// space), so Serial and OpenMP run the same machine code and give the same bits. noinline keeps it so.
+/// space), so Serial and OpenMP run the same machine code and give the same bits (kernels/for_each_member.hpp).
 template <bool Initialize, class Model>
-#if defined(__GNUC__)
-__attribute__((noinline))
-#endif
-void particle_block_host(const ParticleStepData<Model, Kokkos::HostSpace>& d, int member, int block) {
+KUSHNER_SAME_CODE_FOR_ALL_CALLERS void particle_block_host(const ParticleStepData<Model, Kokkos::HostSpace>& d,
+                                                           int member, int block) {
   constexpr int n = Model::state_dim;
   constexpr int B = host_particle_block;
   const int begin = block * B;

@@ -14,6 +14,7 @@
 // cosh(z), integrated by Gauss-Hermite quadrature. Checked numerically in notes/benes_check.py.
 #include "kernels/bank.hpp"
 #include "kernels/errors.hpp"
+#include "kernels/for_each_member.hpp"
 #include "kernels/math.hpp"
 #include "kernels/status.hpp"
 #include "models/benes_model.hpp"
@@ -147,9 +148,9 @@ class BenesFilter {
 
  private:
   void launch(const BankVector<MemSpace>& dy, double dt, bool update) {
-    Kokkos::parallel_for("kushner::benes_filter_step", Kokkos::RangePolicy<ExecSpace>(space_, 0, mean_.extent(0)),
-                         BenesFilterStep<MemSpace>{augmented_mean_, augmented_cov_, dy, mean_, variance_, status_, rule_,
-                                                   r_, dt, update});
+    parallel_for_members("kushner::benes_filter_step", space_, mean_.extent(0),
+                         BenesFilterStep<MemSpace>{augmented_mean_, augmented_cov_, dy, mean_, variance_, status_,
+                                                   rule_, r_, dt, update});
   }
 
   ExecSpace space_;

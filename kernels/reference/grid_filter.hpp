@@ -17,6 +17,7 @@
 // One member per work item, sequential over the grid: a reference, not a fast path.
 #include "kernels/bank.hpp"
 #include "kernels/errors.hpp"
+#include "kernels/for_each_member.hpp"
 #include "kernels/linear_algebra.hpp"
 #include "kernels/math.hpp"
 #include "kernels/status.hpp"
@@ -283,10 +284,10 @@ class GridFilter {
     const Mat<p, p> r = model_.observation_noise(t);
     Mat<p, p> root;
     KUSHNER_REQUIRE(cholesky(r * transpose(r), root), Model::name << ": R R^T not positive definite");
-    Kokkos::parallel_for("kushner::grid_filter_step", Kokkos::RangePolicy<ExecSpace>(space_, 0, mean_.extent(0)),
-                         GridFilterStep<Model, MemSpace>{model_, mass_, next_, center_, spacing_, dy, mean_, covariance_,
-                                                         resolution_, status_, cholesky_inverse(root), n_, half_width_,
-                                                         t, dt});
+    parallel_for_members(
+        "kushner::grid_filter_step", space_, mean_.extent(0),
+        GridFilterStep<Model, MemSpace>{model_, mass_, next_, center_, spacing_, dy, mean_, covariance_, resolution_,
+                                        status_, cholesky_inverse(root), n_, half_width_, t, dt});
   }
 
   const BankVector<MemSpace>& posterior_mean() const { return mean_; }

@@ -11,6 +11,7 @@
 // work item; the filter bank (KB there) has its own continuous-time implementation.
 #include "kernels/bank.hpp"
 #include "kernels/errors.hpp"
+#include "kernels/for_each_member.hpp"
 #include "kernels/linear_algebra.hpp"
 #include "kernels/status.hpp"
 #include "models/linear_model.hpp"
@@ -81,7 +82,7 @@ class KalmanBucyReference {
   /// Step k: [k dt, (k + 1) dt] with increments dy (member, i).
   void step(long, double dt, const BankVector<MemSpace>& dy) {
     KUSHNER_REQUIRE(dy.extent(0) == mean_.extent(0) && dy.extent_int(1) == N, "dy has the wrong shape");
-    Kokkos::parallel_for("kushner::kalman_reference_step", Kokkos::RangePolicy<ExecSpace>(space_, 0, mean_.extent(0)),
+    parallel_for_members("kushner::kalman_reference_step", space_, mean_.extent(0),
                          KalmanReferenceStep<N, MemSpace>{model_, mean_, dy, covariance_, status_, dt});
   }
 

@@ -1,0 +1,57 @@
+#pragma once
+// Member kernels: one functor call per ensemble member, the same bits on every host backend.
+//
+// GCC vectorizes the loop of Kokkos' Serial backend around an inlined functor but not the OpenMP backend's,
+// and a vectorized loop calls glibc's vector sin/cos/exp/log (kernels/particle_filter/vector_math.hpp), which
+// differ from the scalar ones in the last bits: the same kernel gave Serial and OpenMP results one ulp apart
+// (Box-Muller of the initial states, -march=native). So on the host the members go in fixed chunks through
+// one function per functor type that is never inlined or cloned: every backend and every thread count runs
+// the same machine code on the same chunks. On a GPU it is a RangePolicy over the members.
+#include <Kokkos_Core.hpp>
+
+#include <string>
+#include <type_traits>
+
+// A host function compiled once for all its callers (no inlining, no call-site specialized clones).
+#if defined(__GNUC__) && !defined(__clang__) && !defined(__CUDACC__)
+#define KUSHNER_SAME_CODE_FOR_ALL_CALLERS __attribute__((noipa))
+#elif defined(__GNUC__) || defined(__clang__)
+#define KUSHNER_SAME_CODE_FOR_ALL_CALLERS __attribute__((noinline))
+#else
+#define KUSHNER_SAME_CODE_FOR_ALL_CALLERS
+#endif
+
+namespace kushner {
+
+/// Members per host work item: small enough that 200 members keep 2 threads busy, large enough for SIMD.
+constexpr int host_member_chunk = 32;
+
+template <class Functor>
+KUSHNER_SAME_CODE_FOR_ALL_CALLERS void run_member_chunk(const Functor& f, int begin, int end) {
+  for (int member = begin; member < end; ++member) f(member);
+}
+
+template <class Functor>
+struct MemberChunks {
+  Functor f;
+  int members;
+  void operator()(const int chunk) const {
+    const int begin = chunk * host_member_chunk;
+    run_member_chunk(f, begin, members - begin < host_member_chunk ? members : begin + host_member_chunk);
+  }
+};
+
+/// f(member) for member in [0, members). No fence.
+template <class ExecSpace, class Functor>
+void parallel_for_members(const std::string& name, const ExecSpace& space, long members, const Functor& f) {
+  const int m = static_cast<int>(members);
+  if constexpr (std::is_same<typename ExecSpace::memory_space, Kokkos::HostSpace>::value) {
+    Kokkos::parallel_for(name,
+                         Kokkos::RangePolicy<ExecSpace>(space, 0, (m + host_member_chunk - 1) / host_member_chunk),
+                         MemberChunks<Functor>{f, m});
+  } else {
+    Kokkos::parallel_for(name, Kokkos::RangePolicy<ExecSpace>(space, 0, m), f);
+  }
+}
+
+}  // namespace kushner
