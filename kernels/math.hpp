@@ -50,6 +50,19 @@ KOKKOS_INLINE_FUNCTION double quiet_nan() {
 
 KOKKOS_INLINE_FUNCTION double square(double v) { return v * v; }
 
+/// c = cos(2 pi u), s = sin(2 pi u). On a GPU CUDA's sincospi: no range reduction and one polynomial pair for
+/// both (the angle 2 pi u is never rounded); elsewhere libm's (or libmvec's) cos and sin of the rounded angle.
+KOKKOS_INLINE_FUNCTION void cos_sin_two_pi(double u, double& c, double& s) {
+#if defined(__CUDA_ARCH__)
+  ::sincospi(2.0 * u, &s, &c);
+#else
+  // The same angle twice, as (2 pi) u and pi (2 u): equal bits (both products are exact before the one
+  // rounding), but two expressions, so GCC does not fuse cos and sin into sincos, which has no vector version.
+  c = cos(2.0 * pi * u);
+  s = sin(pi * (2.0 * u));
+#endif
+}
+
 /// log(cosh(x)) without overflow for large |x|.
 KOKKOS_INLINE_FUNCTION double log_cosh(double x) {
   const double a = fabs(x);

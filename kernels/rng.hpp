@@ -9,6 +9,8 @@
 // Normals: each Philox block (4 x 32 bits) gives two 52-bit uniforms u1, u2 in (0, 1), and Box-Muller
 // turns them into two independent standard normals sqrt(-2 ln u1) (cos 2 pi u2, sin 2 pi u2). Box-Muller,
 // not a rejection method, so every member uses the same number of blocks per step and counters stay aligned.
+// The truths take component i of their N normals from block i / 2 (normal_vector); the particle filter
+// gives both normals of a block to two particles (kernels/particle_filter/particle_draws.hpp).
 #include "kernels/math.hpp"
 #include "kernels/small_matrix.hpp"
 
@@ -67,14 +69,26 @@ KOKKOS_INLINE_FUNCTION void uniform_pair(const RngKey& key, const Counter& c, do
   u1 = uniform_open(r.v[2], r.v[3]);
 }
 
+struct NormalPair {
+  double z0, z1;
+};
+
+/// Box-Muller: two independent standard normals sqrt(-2 ln u0) (cos 2 pi u1, sin 2 pi u1) from two uniforms.
+/// Returned by value: GCC does not vectorize the host particle kernel when they are written through references.
+KOKKOS_INLINE_FUNCTION NormalPair box_muller(double u0, double u1) {
+  const double radius = math::sqrt(-2.0 * math::log(u0));
+  double c, s;
+  math::cos_sin_two_pi(u1, c, s);
+  return {radius * c, radius * s};
+}
+
 /// Two independent standard normals from one Philox block (Box-Muller).
 KOKKOS_INLINE_FUNCTION void normal_pair(const RngKey& key, const Counter& c, double& z0, double& z1) {
   double u0, u1;
   uniform_pair(key, c, u0, u1);
-  const double radius = math::sqrt(-2.0 * math::log(u0));
-  const double angle = 2.0 * math::pi * u1;
-  z0 = radius * math::cos(angle);
-  z1 = radius * math::sin(angle);
+  const NormalPair z = box_muller(u0, u1);
+  z0 = z.z0;
+  z1 = z.z1;
 }
 
 /// N standard normals for one (member, particle, step): blocks draw = 0 .. ceil(N/2)-1.

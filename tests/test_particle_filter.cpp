@@ -22,8 +22,11 @@ auto to_host(const View& v) {
   return h;
 }
 
+/// Particle j's normal: the cosine (j even) or sine (j odd) normal of block {member, j / 2, step, 0}.
 double normal_draw(Stream stream, int member, int particle, std::uint32_t step) {
-  return normal_vector<1>(RngKey{seed, stream}, member, particle, step)[0];
+  double z0, z1;
+  normal_pair(RngKey{seed, stream}, Counter{std::uint32_t(member), std::uint32_t(particle / 2), step, 0}, z0, z1);
+  return particle % 2 == 0 ? z0 : z1;
 }
 
 class ParticleKernels : public ::testing::TestWithParam<ParticleKernel> {};
@@ -32,7 +35,7 @@ TEST_P(ParticleKernels, FirstStepMatchesHandComputation) {
   SineModel model;
   model.prior_mean[0] = 0.3;
   model.prior_cov(0, 0) = 0.5;
-  const int members = 3, particles = 300;  // more than one host block
+  const int members = 3, particles = 301;  // more than one host block; odd: the last particle has no pair
   ParticleFilterOptions options;
   options.kernel = GetParam();
   options.ess_threshold = 0.0;  // no resampling: the weights must be exactly the likelihoods

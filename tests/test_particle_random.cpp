@@ -1,7 +1,7 @@
 // The host particle kernel's vectorizable Philox (kernels/particle_filter/simd_random.hpp) against Random123's
 // (kernels/rng.hpp, used on the GPU): the same uniforms bit for bit, the same normals to the last bits of the
-// math library.
-#include "kernels/particle_filter/simd_random.hpp"
+// math library; and the particle pairs' draws (kernels/particle_filter/particle_draws.hpp).
+#include "kernels/particle_filter/particle_draws.hpp"
 
 #include <gtest/gtest.h>
 
@@ -28,12 +28,51 @@ TEST(SimdPhilox, UniformsBitIdenticalToRandom123) {
           }
 }
 
-TEST(SimdPhilox, NormalsMatchRandom123) {
+TEST(SimdPhilox, ParticlePairDrawsMatchRandom123) {
   const RngKey key{7, Stream::particle_initial};
-  for (std::uint32_t particle = 0; particle < 2000; ++particle) {
-    const Vec<3> a = normal_vector<3>(key, 5, particle, 11), b = simd::normal_vector<3>(key, 5, particle, 11);
-    for (int i = 0; i < 3; ++i) ASSERT_NEAR(a[i], b[i], 1e-15 * (1.0 + std::abs(a[i]))) << particle << " " << i;
+  for (int pair = 0; pair < 2000; ++pair)
+    for (int i = 0; i < 3; ++i) {
+      const NormalPair a = pair_normals<Random123Draws>(key, 5, pair, 11, i);
+      const NormalPair b = pair_normals<SimdDraws>(key, 5, pair, 11, i);
+      ASSERT_NEAR(a.z0, b.z0, 1e-15 * (1.0 + std::abs(a.z0))) << pair << " " << i;
+      ASSERT_NEAR(a.z1, b.z1, 1e-15 * (1.0 + std::abs(a.z1))) << pair << " " << i;
+    }
+}
+
+TEST(ParticleDraws, PairFollowsTheDocumentedBlocks) {
+  // Component i of particles 2k, 2k + 1: the two Box-Muller normals of block {member, k, step, i}; their
+  // uniforms (after K normals each): block {member, k, step, K}.
+  const RngKey key{20261122, Stream::particle_noise};
+  for (std::uint32_t i = 0; i < 2; ++i) {
+    double z0, z1;
+    normal_pair(key, Counter{3, 17, 9, i}, z0, z1);
+    const NormalPair z = pair_normals<Random123Draws>(key, 3, 17, 9, static_cast<int>(i));
+    EXPECT_EQ(z.z0, z0);
+    EXPECT_EQ(z.z1, z1);
   }
+  double u0, u1, v0, v1;
+  uniform_pair(key, Counter{3, 17, 9, 2}, u0, u1);
+  pair_uniforms<SimdDraws>(key, 3, 17, 9, 2, v0, v1);
+  EXPECT_EQ(v0, u0);
+  EXPECT_EQ(v1, u1);
+}
+
+TEST(ParticleDraws, PairedNormalsAreUncorrelatedUnitNormals) {
+  // 2^20 pairs: the even and odd particles' normals each have variance 1 and correlation 0, within 5 standard
+  // errors (SE of a sample variance of normals sqrt(2 / n), of a correlation 1 / sqrt(n)); P(false alarm) ~ 1e-6.
+  const int pairs = 1 << 20;
+  const RngKey key{11, Stream::particle_noise};
+  double see = 0.0, soo = 0.0, seo = 0.0;
+  for (int k = 0; k < pairs; ++k) {
+    const NormalPair z = pair_normals<SimdDraws>(key, 2, k, 4, 0);
+    see += z.z0 * z.z0;
+    soo += z.z1 * z.z1;
+    seo += z.z0 * z.z1;
+  }
+  const double n = pairs;
+  EXPECT_LT(std::abs(see / n - 1.0), 5.0 * std::sqrt(2.0 / n));
+  EXPECT_LT(std::abs(soo / n - 1.0), 5.0 * std::sqrt(2.0 / n));
+  EXPECT_LT(std::abs(seo / n), 5.0 / std::sqrt(n));  // a pairing that reused one normal would give 1
 }
 
 TEST(SimdPhilox, ExtremeWordsGiveTheOpenIntervalEnds) {

@@ -83,6 +83,8 @@ class ParticleFilterBank {
     block_size_ = use_team_ ? (host_memory ? device_particle_batch * device_particle_team : team_size_ * per_thread)
                             : host_particle_block;
     num_blocks_ = (num_particles + block_size_ - 1) / block_size_;
+    KUSHNER_REQUIRE(block_size_ % 2 == 0,
+                    "particle blocks must hold whole pairs of particles (block of " << block_size_ << ")");
 
     const int n = state_dim;
     x_ = ParticleBank<MemSpace>("kushner::particles", num_particles, num_members, n);

@@ -12,8 +12,8 @@
 #include "kernels/for_each_member.hpp"
 #include "kernels/linear_algebra.hpp"
 #include "kernels/math.hpp"
+#include "kernels/particle_filter/particle_draws.hpp"
 #include "kernels/particle_filter/particle_model_traits.hpp"
-#include "kernels/particle_filter/simd_random.hpp"
 #include "kernels/particle_filter/vector_math.hpp"
 #include "kernels/particle_filter/weighted_moments.hpp"
 #include "kernels/rng.hpp"
@@ -73,31 +73,21 @@ struct ParticleStepData {
   bool initialize = false;          // sample the initial law instead of propagating; no observation
 };
 
-/// Normals from Random123 (GPU, and the reference for the host's vectorizable copy).
-struct Random123Draws {
-  template <int N>
-  KOKKOS_INLINE_FUNCTION static Vec<N> normals(const RngKey& key, int member, int particle, std::uint32_t step) {
-    return normal_vector<N>(key, static_cast<std::uint32_t>(member), static_cast<std::uint32_t>(particle), step);
-  }
-  KOKKOS_INLINE_FUNCTION static double uniform(const RngKey& key, const Counter& c) {
-    double u0, u1;
-    uniform_pair(key, c, u0, u1);
-    return u0;
-  }
-};
+/// Draws per particle and step: the normals of the initial state, or of the Euler-Maruyama step.
+template <class Model, bool Initialize>
+constexpr int particle_draw_dim = Initialize ? Model::state_dim : Model::noise_dim;
 
-/// The same draws from the vectorizable Philox (host block kernel).
-struct SimdDraws {
-  template <int N>
-  KOKKOS_INLINE_FUNCTION static Vec<N> normals(const RngKey& key, int member, int particle, std::uint32_t step) {
-    return simd::normal_vector<N>(key, static_cast<std::uint32_t>(member), static_cast<std::uint32_t>(particle), step);
-  }
-  KOKKOS_INLINE_FUNCTION static double uniform(const RngKey& key, const Counter& c) {
-    double u0, u1;
-    simd::uniform_pair(key, c, u0, u1);
-    return u0;
-  }
-};
+/// The key and step of the particles' draws: their initial states, or step d.step.
+template <bool Initialize, class Model, class MemSpace>
+KOKKOS_INLINE_FUNCTION RngKey particle_draw_key(const ParticleStepData<Model, MemSpace>& d) {
+  return RngKey{d.seed, Initialize ? Stream::particle_initial : Stream::particle_noise};
+}
+template <bool Initialize, class Model, class MemSpace>
+KOKKOS_INLINE_FUNCTION std::uint32_t particle_draw_step(const ParticleStepData<Model, MemSpace>& d) {
+  return Initialize ? 0 : d.step;
+}
+template <class Model, bool Initialize>
+constexpr bool draws_uniform = !Initialize && has_exact_transition<Model>::value;
 
 /// V^{-1} dy of one member: the only observation term the likelihood needs besides h(x).
 template <class Model, class MemSpace>
@@ -105,35 +95,31 @@ KOKKOS_INLINE_FUNCTION Vec<Model::obs_dim> precision_times_dy(const ParticleStep
   return d.observation_precision * load<Model::obs_dim>(d.dy, member);
 }
 
-/// Moves particle `particle` of `member` (x in, x out) and returns its new log-weight, normalized by the
-/// member's previous log-normalizer; -inf for a particle that left the finite numbers (weight zero).
-template <class Draws, bool Initialize, class Model, class MemSpace>
-KOKKOS_INLINE_FUNCTION double update_particle(const ParticleStepData<Model, MemSpace>& d, int member, int particle,
+/// Moves one particle (x in, x out) with its draws (normals z, uniform u) and returns its new log-weight,
+/// normalized by the member's previous log-normalizer; -inf for a particle that left the finite numbers.
+template <bool Initialize, class Model, class MemSpace>
+KOKKOS_INLINE_FUNCTION double update_particle(const ParticleStepData<Model, MemSpace>& d,
+                                              const Vec<particle_draw_dim<Model, Initialize>>& z, double u,
                                               double log_weight, double log_normalizer,
                                               const Vec<Model::obs_dim>& vinv_dy, Vec<Model::state_dim>& x) {
-  constexpr int n = Model::state_dim, p = Model::obs_dim, q = Model::noise_dim;
+  constexpr int n = Model::state_dim, p = Model::obs_dim;
   if constexpr (Initialize) {
-    const Vec<n> z = Draws::template normals<n>(RngKey{d.seed, Stream::particle_initial}, member, particle, 0);
     x = d.initial_mean + d.initial_root * z;
     return 0.0;
   } else {
-  const RngKey key{d.seed, Stream::particle_noise};
-  const Vec<q> z = Draws::template normals<q>(key, member, particle, d.step);
-  if constexpr (has_exact_transition<Model>::value) {
-    const double u = Draws::uniform(key, Counter{static_cast<std::uint32_t>(member), static_cast<std::uint32_t>(particle),
-                                                 d.step, static_cast<std::uint32_t>((q + 1) / 2)});
-    x = d.model.sample_exact_transition(d.t, x, d.dt, z, u);
-  } else {
-    const typename Model::Control u = Model::Control::zero();
-    x = x + d.model.drift(d.t, x, u) * d.dt + d.model.diffusion(d.t, x) * (z * math::sqrt(d.dt));
-  }
-  const Vec<p> h = d.model.observation(d.t + d.dt, x);
-  const double increment = dot(h, vinv_dy) - 0.5 * d.dt * dot(h, d.observation_precision * h);
-  const double l = log_weight - log_normalizer + increment;
-  bool finite = math::is_finite(l);
-  KUSHNER_UNROLL_FULLY
-  for (int i = 0; i < n; ++i) finite = finite & math::is_finite(x[i]);  // `&`: no branch, so GCC can vectorize
-  return finite ? l : -positive_infinity();
+    if constexpr (has_exact_transition<Model>::value) {
+      x = d.model.sample_exact_transition(d.t, x, d.dt, z, u);
+    } else {
+      const typename Model::Control control = Model::Control::zero();
+      x = x + d.model.drift(d.t, x, control) * d.dt + d.model.diffusion(d.t, x) * (z * math::sqrt(d.dt));
+    }
+    const Vec<p> h = d.model.observation(d.t + d.dt, x);
+    const double increment = dot(h, vinv_dy) - 0.5 * d.dt * dot(h, d.observation_precision * h);
+    const double l = log_weight - log_normalizer + increment;
+    bool finite = math::is_finite(l);
+    KUSHNER_UNROLL_FULLY
+    for (int i = 0; i < n; ++i) finite = finite & math::is_finite(x[i]);  // `&`: no branch, so GCC can vectorize
+    return finite ? l : -positive_infinity();
   }
 }
 
@@ -152,13 +138,40 @@ KUSHNER_SAME_CODE_FOR_ALL_CALLERS void particle_block_host(const ParticleStepDat
   const double log_normalizer = d.initialize ? 0.0 : d.log_normalizer(member);
   const Vec<Model::obs_dim> vinv_dy = d.initialize ? Vec<Model::obs_dim>::zero() : precision_times_dy(d, member);
   double l[B], e[B], dx[n][B];
-
+  // The block's draws first, pair by pair, into particle-contiguous arrays that the particle loop reads.
+  constexpr int K = particle_draw_dim<Model, Initialize>;
+  double z[K][B], u[B];
+  const RngKey key = particle_draw_key<Initialize>(d);
+  const std::uint32_t step = particle_draw_step<Initialize>(d);
+  const int first_pair = begin / 2;   // blocks start at even particles
+  const int pairs = (count + 1) / 2;  // an odd count's last particle is the even half of its pair
+  for (int i = 0; i < K; ++i) {
+    KUSHNER_SIMD
+    for (int k = 0; k < pairs; ++k) {
+      const NormalPair zk = pair_normals<SimdDraws>(key, member, first_pair + k, step, i);
+      z[i][2 * k] = zk.z0;
+      z[i][2 * k + 1] = zk.z1;
+    }
+  }
+  if constexpr (draws_uniform<Model, Initialize>) {
+    KUSHNER_SIMD
+    for (int k = 0; k < pairs; ++k) {
+      double u0, u1;
+      pair_uniforms<SimdDraws>(key, member, first_pair + k, step, K, u0, u1);
+      u[2 * k] = u0;
+      u[2 * k + 1] = u1;
+    }
+  }
 KUSHNER_SIMD
   for (int j = 0; j < count; ++j) {
     Vec<n> xj;
+    Vec<K> zj;
     KUSHNER_UNROLL_FULLY
     for (int i = 0; i < n; ++i) xj[i] = xs[i][j];
-    const double lj = update_particle<SimdDraws, Initialize>(d, member, begin + j, lw[j], log_normalizer, vinv_dy, xj);
+    KUSHNER_UNROLL_FULLY
+    for (int i = 0; i < K; ++i) zj[i] = z[i][j];
+    const double uj = draws_uniform<Model, Initialize> ? u[j] : 0.0;
+    const double lj = update_particle<Initialize>(d, zj, uj, lw[j], log_normalizer, vinv_dy, xj);
     KUSHNER_UNROLL_FULLY
     for (int i = 0; i < n; ++i) xs[i][j] = xj[i];
     lw[j] = lj;
@@ -268,11 +281,11 @@ struct ParticleTeamStep {
     if (d.status(member) == Status::ok) {
       ref = load<n>(d.reference, member);
       if (d.initialize) {
-        step_particles<true>(member, begin + rank, end, threads, ref, shift, w);
+        step_particles<true>(member, begin, end, rank, threads, ref, shift, w);
       } else {
         const Vec<p> vinv_dy = precision_times_dy(d, member);
         shift = log_weight_bound(d, member, vinv_dy);
-        step_particles<false>(member, begin + rank, end, threads, ref, shift, w);
+        step_particles<false>(member, begin, end, rank, threads, ref, shift, w);
       }
     }
     team_sum(team, buffer, w);
@@ -298,9 +311,12 @@ struct ParticleTeamStep {
     if (e > 0.0) w.add_weight(e, dx);
   }
 
+  /// The particles [begin, end) of `member`, pairs (2 k, 2 k + 1) sharing their draws: thread `rank` takes
+  /// pairs begin / 2 + rank, + threads, ..., B at a time with all their loads issued first.
   template <bool Initialize>
-  KOKKOS_INLINE_FUNCTION void step_particles(int member, int first, int end, int threads, const Vec<n>& ref,
+  KOKKOS_INLINE_FUNCTION void step_particles(int member, int begin, int end, int rank, int threads, const Vec<n>& ref,
                                              double shift, WeightedMoments<n>& w) const {
+    constexpr int B = (P + 1) / 2;  // pairs per batch
     const double log_normalizer = Initialize ? 0.0 : d.log_normalizer(member);
     const Vec<p> vinv_dy = Initialize ? Vec<p>::zero() : precision_times_dy(d, member);
     double top = -positive_infinity();
@@ -308,12 +324,15 @@ struct ParticleTeamStep {
     double* const xm = &d.x(0, member, 0);
     double* const lwm = &d.log_weight(0, member);
     const std::size_t x_stride = d.x.stride_2();  // LayoutLeft: x(j, member, i) = xm[j + i * x_stride]
-    for (int base = first; base < end; base += P * threads) {
-      Vec<n> x[P];
-      double lw[P];
+    const int end_pair = (end + 1) / 2;
+    const RngKey key = particle_draw_key<Initialize>(d);
+    const std::uint32_t step = particle_draw_step<Initialize>(d);
+    for (int base = begin / 2 + rank; base < end_pair; base += B * threads) {
+      Vec<n> x[2 * B];
+      double lw[2 * B];
       KUSHNER_DEVICE_UNROLL
-      for (int k = 0; k < P; ++k) {
-        const int j = base + k * threads;
+      for (int k = 0; k < 2 * B; ++k) {
+        const int j = 2 * (base + (k / 2) * threads) + k % 2;
         if (j < end) {
           KUSHNER_DEVICE_UNROLL
           for (int i = 0; i < n; ++i) x[k][i] = xm[j + i * x_stride];
@@ -321,11 +340,25 @@ struct ParticleTeamStep {
         }
       }
       KUSHNER_DEVICE_UNROLL
-      for (int k = 0; k < P; ++k) {
-        const int j = base + k * threads;
-        if (j < end) {
-          const double l =
-              update_particle<Random123Draws, Initialize>(d, member, j, lw[k], log_normalizer, vinv_dy, x[k]);
+      for (int b = 0; b < B; ++b) {
+        const int pair = base + b * threads;
+        if (pair >= end_pair) continue;
+        constexpr int K = particle_draw_dim<Model, Initialize>;
+        Vec<K> z[2];
+        double u[2] = {0.0, 0.0};
+        KUSHNER_DEVICE_UNROLL
+        for (int i = 0; i < K; ++i) {
+          const NormalPair zi = pair_normals<Random123Draws>(key, member, pair, step, i);
+          z[0][i] = zi.z0;
+          z[1][i] = zi.z1;
+        }
+        if constexpr (draws_uniform<Model, Initialize>)
+          pair_uniforms<Random123Draws>(key, member, pair, step, K, u[0], u[1]);
+        KUSHNER_DEVICE_UNROLL
+        for (int h = 0; h < 2; ++h) {
+          const int j = 2 * pair + h, k = 2 * b + h;
+          if (j >= end) continue;
+          const double l = update_particle<Initialize>(d, z[h], u[h], lw[k], log_normalizer, vinv_dy, x[k]);
           KUSHNER_DEVICE_UNROLL
           for (int i = 0; i < n; ++i) xm[j + i * x_stride] = x[k][i];
           lwm[j] = l;

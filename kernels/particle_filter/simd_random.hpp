@@ -1,9 +1,9 @@
 #pragma once
-// Philox4x32-10 and Box-Muller in a form GCC vectorizes inside `#pragma omp simd` loops: 32-bit words held in
-// 64-bit lanes (Random123's array structs do not vectorize) and the uniform built from its bit pattern
-// (uint64 -> double conversion has no AVX2 instruction). Same counters, same 52-bit uniforms as
-// kernels/rng.hpp, bit for bit (tests/test_particle_random.cpp); only the host particle kernel uses it, the
-// GPU keeps Random123's version, which uses the hardware's 32-bit multiply-high.
+// Philox4x32-10 in a form GCC vectorizes inside `#pragma omp simd` loops: 32-bit words held in 64-bit lanes
+// (Random123's array structs do not vectorize) and the uniform built from its bit pattern (uint64 -> double
+// conversion has no AVX2 instruction). Same counters, same 52-bit uniforms as kernels/rng.hpp, bit for bit
+// (tests/test_particle_random.cpp); only the host particle kernel uses it, the GPU keeps Random123's version,
+// which uses the hardware's 32-bit multiply-high.
 #include "kernels/math.hpp"
 #include "kernels/rng.hpp"
 #include "kernels/small_matrix.hpp"
@@ -55,23 +55,6 @@ KOKKOS_INLINE_FUNCTION void uniform_pair(const RngKey& key, const Counter& c, do
   philox4x32_10(c.member, c.particle, c.step, c.draw, key.seed, static_cast<std::uint32_t>(key.stream), r);
   u0 = uniform_open(r[0], r[1]);
   u1 = uniform_open(r[2], r[3]);
-}
-
-/// N standard normals for one (member, particle, step), the draws of kushner::normal_vector.
-template <int N>
-KOKKOS_INLINE_FUNCTION Vec<N> normal_vector(const RngKey& key, std::uint32_t member, std::uint32_t particle,
-                                            std::uint32_t step) {
-  Vec<N> z;
-  KUSHNER_UNROLL_FULLY
-  for (int i = 0; i < N; i += 2) {
-    double u0, u1;
-    simd::uniform_pair(key, Counter{member, particle, step, static_cast<std::uint32_t>(i / 2)}, u0, u1);
-    const double radius = math::sqrt(-2.0 * math::log(u0));
-    const double angle = 2.0 * math::pi * u1;
-    z[i] = radius * math::cos(angle);
-    if (i + 1 < N) z[i + 1] = radius * math::sin(angle);
-  }
-  return z;
 }
 
 }  // namespace kushner::simd

@@ -1,0 +1,45 @@
+#pragma once
+// The particle filter's random draws. Particles 2k and 2k + 1 of a member share Philox blocks: block
+// {member, k, step, i} gives component i of both particles' normals by Box-Muller (the cosine normal to the
+// even particle, the sine normal to the odd one), and a model with an exact transition sampler takes block
+// i = K (after the K normals) for one uniform each. So one Philox block, one log and one square root serve two
+// particles: the GPU step is bound by instruction issue, and Box-Muller with one normal per block was a
+// quarter of it (perf/particle_filter.md). Random123Draws (GPU) and SimdDraws (the host's SIMD kernel) give
+// the same uniforms bit for bit (tests/test_particle_random.cpp).
+#include "kernels/particle_filter/simd_random.hpp"
+#include "kernels/rng.hpp"
+
+#include <cstdint>
+
+namespace kushner {
+
+/// Uniforms from Random123's Philox (GPU).
+struct Random123Draws {
+  KOKKOS_INLINE_FUNCTION static void uniforms(const RngKey& key, const Counter& c, double& u0, double& u1) {
+    uniform_pair(key, c, u0, u1);
+  }
+};
+
+/// The same uniforms from the vectorizable Philox (host block kernel).
+struct SimdDraws {
+  KOKKOS_INLINE_FUNCTION static void uniforms(const RngKey& key, const Counter& c, double& u0, double& u1) {
+    simd::uniform_pair(key, c, u0, u1);
+  }
+};
+
+/// Component i of the normals of particles 2 pair (z0) and 2 pair + 1 (z1) of `member` at `step`.
+template <class Draws>
+KOKKOS_INLINE_FUNCTION NormalPair pair_normals(const RngKey& key, int member, int pair, std::uint32_t step, int i) {
+  double u0, u1;
+  Draws::uniforms(key, Counter{std::uint32_t(member), std::uint32_t(pair), step, std::uint32_t(i)}, u0, u1);
+  return box_muller(u0, u1);
+}
+
+/// The uniforms of particles 2 pair (u0) and 2 pair + 1 (u1) whose draws also hold K normals each.
+template <class Draws>
+KOKKOS_INLINE_FUNCTION void pair_uniforms(const RngKey& key, int member, int pair, std::uint32_t step, int K,
+                                          double& u0, double& u1) {
+  Draws::uniforms(key, Counter{std::uint32_t(member), std::uint32_t(pair), step, std::uint32_t(K)}, u0, u1);
+}
+
+}  // namespace kushner
