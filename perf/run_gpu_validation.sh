@@ -5,42 +5,48 @@
 #   bench     truth step and whole filter bank at M = 1e6 (member-steps/s), with the stream-copy floor
 #   compare   `kushner compare` on the sine model (two seeds) and the cubic oscillator: M = 1e4, N = 4096,
 #             T = 10, dt = 1e-3 (the tables of the filter-bank and compare issues)
-# then, for the particle filter's own benchmarks and the PyTorch comparison: perf/run_gpu_benchmarks.sh
-# (its phases compare and sizes reuse build-cuda/).
+#   pf        perf/run_gpu_benchmarks.sh's phases (PF_PHASES, default "compare sizes"): the particle-filter
+#             step at M = 1000, N = 65536 beside PyTorch eager and torch.compile in the same call, then every size
+# Results: $OUT/results.tgz (every log, JSON and summary) and $OUT/steps.log.
 #   OUT=<dir> KUSHNER_PHASES="build test" perf/run_gpu_validation.sh
 set -uo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 out=${OUT:-$here/gpu-out}
 mkdir -p "$out"
+work=$(mktemp -d)  # collected here, packed into $out at the end (the device tool returns few files)
 build=$here/build-cuda
 phases=" ${KUSHNER_PHASES:-build test bench compare} "
 want() { [[ "$phases" == *" $1 "* ]]; }
-export PATH=/usr/local/cuda/bin:$PATH CMAKE_POLICY_VERSION_MINIMUM=3.5
+export PATH=/usr/local/cuda/bin:$PATH CMAKE_POLICY_VERSION_MINIMUM=3.5 OMP_PROC_BIND=false
 status=0
-step() {  # step NAME CMD...: output to $out/NAME.log, time and exit code to steps.log
+step() {  # step NAME CMD...: output to NAME.log, time and exit code to steps.log
   local name=$1; shift
   local t0=$SECONDS
-  "$@" > "$out/$name.log" 2>&1
+  "$@" > "$work/$name.log" 2>&1
   local rc=$?
-  echo "$name: exit $rc, $((SECONDS - t0)) s" | tee -a "$out/steps.log"
+  echo "$name: exit $rc, $((SECONDS - t0)) s" | tee -a "$work/steps.log"
   [ $rc -eq 0 ] || status=1
   return $rc
 }
-nvidia-smi --query-gpu=name,memory.total --format=csv,noheader > "$out/gpu.txt" 2>&1
+pack() { cp "$work/steps.log" "$out/" 2>/dev/null; tar -czf "$out/results.tgz" -C "$work" .; }
+trap pack EXIT
+nvidia-smi --query-gpu=name,memory.total,clocks.max.sm,driver_version --format=csv,noheader > "$work/gpu.txt" 2>&1
+git -C "$here" describe --always --dirty --abbrev=12 > "$work/git.txt" 2>&1
+cat "$work/gpu.txt"
 
 if want build; then
   step configure cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON \
-    -DKUSHNER_ENABLE_OPENMP=ON -DKUSHNER_ENABLE_THRUST=ON || exit 1
-  step build cmake --build "$build" -j16 || { tail -40 "$out/build.log"; exit 1; }
+    -DKUSHNER_ENABLE_OPENMP=ON -DKUSHNER_ENABLE_THRUST=ON || { cat "$work/configure.log"; exit 1; }
+  step build cmake --build "$build" -j16 || { grep -B2 -A12 -m3 "error" "$work/build.log"; exit 1; }
 fi
 if want test; then
   (cd "$build" && step ctest ctest -j4 --output-on-failure --timeout 400)
-  grep -E "tests passed|Failed|\*\*\*" "$out/ctest.log"
+  grep -E "tests passed|Failed|\*\*\*|Total Test" "$work/ctest.log"
 fi
 if want bench; then
   for b in bench_simulate_truth bench_filter_bank; do
     KUSHNER_BACKEND=cuda step "$b" "$build/perf/$b" --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
-    grep -E "median|Copy" "$out/$b.log"
+    grep -E "median|Copy" "$work/$b.log"
   done
 fi
 if want compare; then
@@ -48,7 +54,13 @@ if want compare; then
   for run in "sine 1" "sine 2" "cubic-oscillator 1"; do
     set -- $run
     KUSHNER_BACKEND=cuda step "compare-$1-seed$2" "$build/kushner" compare --model "$1" --seed "$2" "${common[@]}" \
-      --out "$out/compare-$1-seed$2"
+      --out "$work/compare-$1-seed$2"
+    cat "$work/compare-$1-seed$2.log"
   done
+fi
+if want pf; then
+  OUT="$work/pf" KUSHNER_PHASES="${PF_PHASES:-compare sizes}" KUSHNER_REPETITIONS="${KUSHNER_REPETITIONS:-10}" \
+    bash "$here/perf/run_gpu_benchmarks.sh" > "$work/pf.log" 2>&1 || status=1
+  cat "$work/pf/summary.txt" 2>/dev/null
 fi
 exit $status
