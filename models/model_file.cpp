@@ -1,4 +1,7 @@
-#include "models/model_file.hpp"
+#include "models/polynomial_spec.hpp"
+
+#include "kernels/errors.hpp"
+#include "models/polynomial_monomials.hpp"
 
 #include <toml++/toml.h>
 
@@ -140,24 +143,6 @@ std::map<std::vector<int>, int> monomial_indices(int n) {
   return index;
 }
 
-void check_covariance_in_file(const std::string& path, const std::string& key, int n, const std::vector<double>& m,
-                              bool allow_singular) {
-  try {
-    switch (n) {
-      case 1:
-        check_covariance(key, Mat<1, 1>{{{m[0]}}}, allow_singular);
-        break;
-      case 2:
-        check_covariance(key, Mat<2, 2>{{{m[0], m[1]}, {m[2], m[3]}}}, allow_singular);
-        break;
-      default:
-        check_covariance(key, Mat<3, 3>{{{m[0], m[1], m[2]}, {m[3], m[4], m[5]}, {m[6], m[7], m[8]}}}, allow_singular);
-    }
-  } catch (const InputError& e) {
-    throw InputError(path + ": " + e.what());
-  }
-}
-
 PolynomialModelSpec read_spec(const toml::table& root, const std::string& path) {
   const ModelFileReader in(path);
   in.only_known_keys(root, "", {"state_dim", "name", "description", "drift", "diffusion", "observation", "initial"});
@@ -256,14 +241,6 @@ PolynomialModelSpec read_spec(const toml::table& root, const std::string& path) 
   in.array(observation, "observation.", "R", true, R_dims, spec.R);
   std::vector<int> c0_dims = {spec.p};
   if (!in.array(observation, "observation.", "c0", false, c0_dims, spec.c0)) spec.c0.assign(spec.p, 0.0);
-  {
-    std::vector<double> V(spec.p * spec.p, 0.0);  // R R^T, checked like every model's (models/model_checks.hpp)
-    for (int i = 0; i < spec.p; ++i)
-      for (int j = 0; j < spec.p; ++j)
-        for (int k = 0; k < spec.p; ++k) V[i * spec.p + j] += spec.R[i * spec.p + k] * spec.R[j * spec.p + k];
-    check_covariance_in_file(path, "observation.R: R R^T", spec.p, V, /*allow_singular=*/false);
-  }
-
   // Initial laws.
   const toml::table* initial = in.table(root, "initial", true);
   in.only_known_keys(*initial, "initial.", {"x0_mean", "x0_cov", "prior_mean", "prior_cov"});
@@ -272,8 +249,6 @@ PolynomialModelSpec read_spec(const toml::table& root, const std::string& path) 
   in.array(initial, "initial.", "x0_cov", true, matrix_dims, spec.x0_cov);
   if (!in.array(initial, "initial.", "prior_mean", false, vector_dims, spec.prior_mean)) spec.prior_mean = spec.x0_mean;
   if (!in.array(initial, "initial.", "prior_cov", false, matrix_dims, spec.prior_cov)) spec.prior_cov = spec.x0_cov;
-  check_covariance_in_file(path, "initial.x0_cov", spec.n, spec.x0_cov, /*allow_singular=*/true);
-  check_covariance_in_file(path, "initial.prior_cov", spec.n, spec.prior_cov, /*allow_singular=*/true);
   return spec;
 }
 

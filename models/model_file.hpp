@@ -1,32 +1,11 @@
 #pragma once
-// `--model-file FILE`: a polynomial model (models/polynomial_model.hpp) read from a TOML file (host only; the
-// parser, toml++, lives in models/model_file.cpp). The format, with n = state_dim (1..3):
-//   state_dim = 2                    # required
-//   name = "..."                     # optional, for reports; description = "..." likewise
-//   [drift]                          # f_k = a0[k] + sum_i a1[k][i] x_i + sum_ij a2[k][i][j] x_i x_j + ... + a4
-//   a0 = [...]                       # n            all optional (absent: zero)
-//   a1 = [[...], ...]                # n x n
-//   a2, a3, a4                       # n x n x n, n x n x n x n, n x n x n x n x n (nested arrays)
-//   [[drift.terms]]                  # optional, repeatable: coefficient * prod_i x_i^powers[i] added to f_component
-//   component = 2                    #   1-based
-//   powers = [3, 0]                  #   n exponents, total degree <= 4
-//   coefficient = 0.125
-//   [diffusion]
-//   b = [[...], ...]                 # required, n x q (q <= n): dx = f dt + b dw
-//   [observation]                    # dy = (c0 + C x) dt + R dv
-//   C = [[...], ...]                 # required, p x n (p <= n)
-//   R = [[...], ...]                 # required, p x p, R R^T positive definite
-//   c0 = [...]                       # optional, p (absent: zero)
-//   [initial]
-//   x0_mean = [...]                  # required, n: the truths' initial law
-//   x0_cov = [[...], ...]            # required, n x n, positive semidefinite
-//   prior_mean, prior_cov            # optional: the filters' initial law (absent: the truths')
-// Every error is one InputError line "FILE: KEY: what is wrong"; unknown keys are errors too (a typo would
-// otherwise silently leave a coefficient zero).
+// `--model-file FILE`: the polynomial model (models/polynomial_model.hpp) a model file describes
+// (models/polynomial_spec.hpp: the format), its record in summary.json, and the dispatch on its dimension.
 #include "kernels/errors.hpp"
 #include "models/model_checks.hpp"
 #include "models/parameters.hpp"
 #include "models/polynomial_model.hpp"
+#include "models/polynomial_spec.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -36,22 +15,19 @@
 
 namespace kushner {
 
-/// A model file's content, checked: sizes n (state), p (observation rows), q (diffusion columns); matrices
-/// row-major; `monomial` (n x polynomial_monomial_count(n)) holds the coefficients of degree 2..4 in the
-/// order of polynomial_monomial().
-struct PolynomialModelSpec {
-  std::string path, label, description;
-  int n = 0, p = 0, q = 0;
-  std::vector<double> a0, a1, monomial, b, c0, C, R, x0_mean, x0_cov, prior_mean, prior_cov;
-};
+/// check_covariance for a matrix of the file: InputError "path: key: ...".
+template <int N>
+void check_file_covariance(const PolynomialModelSpec& spec, const std::string& key, const Mat<N, N>& m,
+                           bool allow_singular) {
+  try {
+    check_covariance(key, m, allow_singular);
+  } catch (const InputError& e) {
+    throw InputError(spec.path + ": " + e.what());
+  }
+}
 
-/// Reads and checks `path`; InputError "path: key: ..." for a file that cannot be read, is not TOML, lacks a
-/// required key, has an unknown key, a value of the wrong type or shape, or a covariance that is not one.
-PolynomialModelSpec read_polynomial_model_file(const std::string& path);
-
-/// The same from TOML text; `path` only names the source in messages.
-PolynomialModelSpec parse_polynomial_model(const std::string& text, const std::string& path);
-
+/// The model of a checked file; InputError "path: key: ..." unless R R^T is positive definite and x0_cov,
+/// prior_cov are covariances.
 template <int N>
 PolynomialModel<N> make_polynomial_model(const PolynomialModelSpec& spec, const PolynomialModelSource* source) {
   KUSHNER_REQUIRE(spec.n == N, "model file has state_dim " << spec.n << ", not " << N);
@@ -77,6 +53,11 @@ PolynomialModel<N> make_polynomial_model(const PolynomialModelSpec& spec, const 
     for (int j = 0; j < N; ++j) model.C(i, j) = spec.C[i * N + j];
     for (int j = 0; j < spec.p; ++j) model.R(i, j) = spec.R[i * spec.p + j];
   }
+  // R is the file's p x p block with the identity below it: R R^T is positive definite when the block's is,
+  // and the pivot numbers are the block's.
+  check_file_covariance(spec, "observation.R: R R^T", model.R * transpose(model.R), /*allow_singular=*/false);
+  check_file_covariance(spec, "initial.x0_cov", model.x0_cov, /*allow_singular=*/true);
+  check_file_covariance(spec, "initial.prior_cov", model.prior_cov, /*allow_singular=*/true);
   return model;
 }
 

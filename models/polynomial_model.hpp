@@ -13,45 +13,13 @@
 #include "kernels/small_matrix.hpp"
 #include "models/drift_forms.hpp"
 #include "models/initial_law.hpp"
+#include "models/polynomial_monomials.hpp"
 
 #include <cstring>
 #include <type_traits>
 #include <utility>
 
 namespace kushner {
-
-/// x_var[0] x_var[1] ... x_var[degree - 1], var sorted.
-struct Monomial {
-  int degree;
-  int var[4];
-};
-
-/// Monomials of degree 2..4 in n variables, numbered by degree, then lexicographically: t-th one.
-KOKKOS_INLINE_FUNCTION constexpr Monomial polynomial_monomial(int n, int t) {
-  int index = 0;
-  for (int degree = 2; degree <= 4; ++degree) {
-    int v[4] = {0, 0, 0, 0};
-    while (true) {
-      if (index == t) {
-        Monomial m{degree, {-1, -1, -1, -1}};
-        for (int p = 0; p < degree; ++p) m.var[p] = v[p];
-        return m;
-      }
-      ++index;
-      int p = degree - 1;  // next sorted index tuple
-      while (p >= 0 && v[p] == n - 1) --p;
-      if (p < 0) break;
-      ++v[p];
-      for (int r = p + 1; r < degree; ++r) v[r] = v[p];
-    }
-  }
-  return Monomial{0, {-1, -1, -1, -1}};
-}
-
-/// Number of monomials of degree 2..4 in n variables.
-KOKKOS_INLINE_FUNCTION constexpr int polynomial_monomial_count(int n) {
-  return n * (n + 1) / 2 + n * (n + 1) * (n + 2) / 6 + n * (n + 1) * (n + 2) * (n + 3) / 24;
-}
 
 namespace detail {
 
@@ -90,6 +58,22 @@ template <int N, int T, int P>
 KOKKOS_INLINE_FUNCTION constexpr bool first_occurrence() {
   constexpr Monomial m = polynomial_monomial(N, T);
   return P < m.degree && (P == 0 || m.var[P] != m.var[P - 1]);
+}
+
+/// Whether positions P < Q of monomial T stand for a pair of its variables {var[P], var[Q]} counted once:
+/// var[P] at its first occurrence, var[Q] at a different variable's first occurrence or var[P]'s second.
+template <int N, int T, int P, int Q>
+KOKKOS_INLINE_FUNCTION constexpr bool hessian_pair() {
+  constexpr Monomial m = polynomial_monomial(N, T);
+  return first_occurrence<N, T, P>() && P < Q && Q < m.degree &&
+         (first_occurrence<N, T, Q>() || (Q == P + 1 && m.var[Q] == m.var[P]));
+}
+/// d^2 x^alpha / d x_u d x_w over the product of the remaining variables: m_u (m_u - 1) or m_u m_w.
+template <int N, int T, int P, int Q>
+KOKKOS_INLINE_FUNCTION constexpr double hessian_factor() {
+  constexpr Monomial m = polynomial_monomial(N, T);
+  constexpr int mp = monomial_multiplicity<N, T, P>(), mq = monomial_multiplicity<N, T, Q>();
+  return m.var[P] == m.var[Q] ? mp * (mp - 1) : mp * mq;
 }
 
 /// E[x_v[0] ... x_v[d-1]] for x ~ N(m, P), d = 0..4 (Isserlis: sum over the pairings).
@@ -157,46 +141,14 @@ struct PolynomialModel : InitialLaw<N> {
   /// d f_k / d x_u: a1 plus, per monomial and variable u in it, (c * multiplicity) times the other variables.
   KOKKOS_INLINE_FUNCTION Mat<N, N> drift_jacobian(double, const Vec<N>& x, const Control&) const {
     Mat<N, N> J = a1;
-    detail::static_for<num_monomials>([&](auto t) {
-      constexpr int T = decltype(t)::value;
-      constexpr Monomial m = polynomial_monomial(N, T);
-      detail::static_for<4>([&](auto position) {
-        constexpr int p = decltype(position)::value;
-        if constexpr (detail::first_occurrence<N, T, p>()) {
-          constexpr double multiplicity = detail::monomial_multiplicity<N, T, p>();
-          for (int k = 0; k < N; ++k)
-            J(k, m.var[p]) += detail::monomial_product<N, T, p>(x, coefficient[k][T] * multiplicity);
-        }
-      });
-    });
+    detail::static_for<num_monomials>([&](auto t) { add_jacobian_terms<decltype(t)::value>(x, J); });
     return J;
   }
 
-  /// Hessian of f_k: per monomial and pair of its variables {u, w}, c * (multiplicities) * (the rest).
+  /// Hessian of f_k: per monomial and pair of its variables {u, w}, c * (multiplicities) times the others.
   KOKKOS_INLINE_FUNCTION Mat<N, N> drift_hessian(double, const Vec<N>& x, const Control&, int k) const {
     Mat<N, N> H = Mat<N, N>::zero();
-    detail::static_for<num_monomials>([&](auto t) {
-      constexpr int T = decltype(t)::value;
-      constexpr Monomial m = polynomial_monomial(N, T);
-      detail::static_for<4>([&](auto first) {
-        constexpr int p = decltype(first)::value;
-        if constexpr (detail::first_occurrence<N, T, p>()) {
-          detail::static_for<4>([&](auto second) {
-            constexpr int q = decltype(second)::value;
-            // the pair {var[p], var[q]}: var[q] a different variable's first occurrence, or var[p]'s second
-            if constexpr (q > p && q < m.degree &&
-                          (detail::first_occurrence<N, T, q>() || (q == p + 1 && m.var[q] == m.var[p]))) {
-              constexpr int mp = detail::monomial_multiplicity<N, T, p>();
-              constexpr int mq = detail::monomial_multiplicity<N, T, q>();
-              constexpr double factor = m.var[p] == m.var[q] ? mp * (mp - 1) : mp * mq;
-              const double value = detail::monomial_product<N, T, p, q>(x, coefficient[k][T] * factor);
-              H(m.var[p], m.var[q]) += value;
-              if (m.var[p] != m.var[q]) H(m.var[q], m.var[p]) += value;
-            }
-          });
-        }
-      });
-    });
+    detail::static_for<num_monomials>([&](auto t) { add_hessian_terms<decltype(t)::value>(x, k, H); });
     return H;
   }
 
@@ -209,23 +161,7 @@ struct PolynomialModel : InitialLaw<N> {
   /// E_N[f], E_N[grad f] for x ~ N(m, P), exactly (Isserlis; d x^alpha / d x_u has the moment of degree - 1).
   KOKKOS_INLINE_FUNCTION GaussianDrift<N> gaussian_drift(double, const Vec<N>& m, const Mat<N, N>& P) const {
     GaussianDrift<N> g{a0 + a1 * m, a1};
-    detail::static_for<num_monomials>([&](auto t) {
-      constexpr int T = decltype(t)::value;
-      constexpr Monomial mono = polynomial_monomial(N, T);
-      const double moment = detail::gaussian_monomial_moment<N>(mono.degree, mono.var, m, P);
-      for (int k = 0; k < N; ++k) g.mean[k] += coefficient[k][T] * moment;
-      detail::static_for<4>([&](auto position) {
-        constexpr int p = decltype(position)::value;
-        if constexpr (detail::first_occurrence<N, T, p>()) {
-          constexpr double multiplicity = detail::monomial_multiplicity<N, T, p>();
-          int rest[4] = {-1, -1, -1, -1};
-          for (int r = 0, s = 0; r < mono.degree; ++r)
-            if (r != p) rest[s++] = mono.var[r];
-          const double rest_moment = detail::gaussian_monomial_moment<N>(mono.degree - 1, rest, m, P);
-          for (int k = 0; k < N; ++k) g.jacobian(k, mono.var[p]) += (coefficient[k][T] * multiplicity) * rest_moment;
-        }
-      });
-    });
+    detail::static_for<num_monomials>([&](auto t) { add_gaussian_terms<decltype(t)::value>(m, P, g); });
     return g;
   }
 
@@ -274,6 +210,54 @@ struct PolynomialModel : InitialLaw<N> {
 
   /// The linear part (Kalman-Bucy): the whole model when the drift has degree <= 1 (filter_unsupported).
   KOKKOS_INLINE_FUNCTION LinearForm<N, N> linear_form(double) const { return {a0, a1, c0, C}; }
+
+  // ---- one monomial's terms (member templates, so that nested compile-time loops see only template
+  // parameters: nvcc does not take a constexpr local of an enclosing lambda as a constant) --------------------
+  template <int T>
+  KOKKOS_INLINE_FUNCTION void add_jacobian_terms(const Vec<N>& x, Mat<N, N>& J) const {
+    detail::static_for<4>([&](auto position) {
+      constexpr int p = decltype(position)::value;
+      if constexpr (detail::first_occurrence<N, T, p>()) {
+        constexpr Monomial m = polynomial_monomial(N, T);
+        constexpr double multiplicity = detail::monomial_multiplicity<N, T, p>();
+        for (int k = 0; k < N; ++k)
+          J(k, m.var[p]) += detail::monomial_product<N, T, p>(x, coefficient[k][T] * multiplicity);
+      }
+    });
+  }
+
+  template <int T>
+  KOKKOS_INLINE_FUNCTION void add_hessian_terms(const Vec<N>& x, int k, Mat<N, N>& H) const {
+    detail::static_for<16>([&](auto pair) {
+      constexpr int p = decltype(pair)::value / 4, q = decltype(pair)::value % 4;
+      if constexpr (detail::hessian_pair<N, T, p, q>()) {
+        constexpr Monomial m = polynomial_monomial(N, T);
+        constexpr double factor = detail::hessian_factor<N, T, p, q>();
+        const double value = detail::monomial_product<N, T, p, q>(x, coefficient[k][T] * factor);
+        H(m.var[p], m.var[q]) += value;
+        if constexpr (m.var[p] != m.var[q]) H(m.var[q], m.var[p]) += value;
+      }
+    });
+  }
+
+  template <int T>
+  KOKKOS_INLINE_FUNCTION void add_gaussian_terms(const Vec<N>& mean, const Mat<N, N>& P, GaussianDrift<N>& g) const {
+    constexpr Monomial m = polynomial_monomial(N, T);
+    const double moment = detail::gaussian_monomial_moment<N>(m.degree, m.var, mean, P);
+    for (int k = 0; k < N; ++k) g.mean[k] += coefficient[k][T] * moment;
+    detail::static_for<4>([&](auto position) {
+      constexpr int p = decltype(position)::value;
+      if constexpr (detail::first_occurrence<N, T, p>()) {
+        constexpr Monomial mono = polynomial_monomial(N, T);
+        constexpr double multiplicity = detail::monomial_multiplicity<N, T, p>();
+        int rest[4] = {-1, -1, -1, -1};
+        for (int r = 0, s = 0; r < mono.degree; ++r)
+          if (r != p) rest[s++] = mono.var[r];
+        const double rest_moment = detail::gaussian_monomial_moment<N>(mono.degree - 1, rest, mean, P);
+        for (int k = 0; k < N; ++k) g.jacobian(k, mono.var[p]) += (coefficient[k][T] * multiplicity) * rest_moment;
+      }
+    });
+  }
 
   // ---- host: the structure of the coefficients, and which filters it rules out --------------------------
   /// Highest degree with a nonzero coefficient (0 for a constant drift).
