@@ -28,10 +28,13 @@ PolynomialModel<N> model_from_file(const std::string& name) {
   return make_polynomial_model<N>(read_polynomial_model_file(examples + name), nullptr);
 }
 
-/// The message of the InputError that parsing `text` throws ("" if none).
+/// The message of the InputError that reading `text` and making its model throws ("" if none).
 std::string parse_error(const std::string& text) {
   try {
-    parse_polynomial_model(text, "m.toml");
+    const PolynomialModelSpec spec = parse_polynomial_model(text, "m.toml");
+    if (spec.n == 1) make_polynomial_model<1>(spec, nullptr);
+    if (spec.n == 2) make_polynomial_model<2>(spec, nullptr);
+    if (spec.n == 3) make_polynomial_model<3>(spec, nullptr);
   } catch (const InputError& e) {
     return e.what();
   }

@@ -109,6 +109,28 @@ for f in s["filters"].values():
 PY
 echo "ok: summary.json records the file and its coefficients; --set x0_mean applies"
 
+# 1-D and 3-D files run too: the double well with the particle and grid filters, Lorenz 63 with every filter
+# its bilinear drift allows. On a quadratic drift the second-order filters, QLF and BILIN are one filter (the
+# Hessian correction and the Gaussian moments are exact): equal to rounding.
+"$kushner" filter --model-file "$examples/double_well.toml" --filters EKF,QLF,POLY3,POLY4,PF,EXACT --members 8 \
+  --particles 512 --T 0.3 --dt 1e-2 --quiet --out "$work/dw"
+"$kushner" filter --model-file "$examples/lorenz63.toml" --members 4 --particles 128 --T 0.02 --dt 1e-3 --quiet \
+  --out "$work/lorenz"
+python3 - "$work/dw/summary.json" "$work/lorenz/summary.json" <<'PY' || fail "double well or Lorenz 63 run"
+import json, math, sys
+dw, lz = (json.load(open(p)) for p in sys.argv[1:3])
+assert dw["filter_order"] == ["EKF", "QLF", "POLY3", "POLY4", "PF", "EXACT"], dw["filter_order"]
+assert dw["filters"]["EXACT"]["estimator"]["kind"] == "grid", dw["filters"]["EXACT"]
+assert lz["filter_order"] == ["EKF", "EKF-DS", "SOF", "SOF-B", "QLF", "BILIN", "MIXED", "ASRE", "KBL", "PF"], lz["filter_order"]
+for s in (dw, lz):
+    for name, f in s["filters"].items():
+        assert math.isfinite(f["rmse_truth"]) and f["diverged"] == 0, (name, f)
+f = lz["filters"]
+for name in ("SOF", "SOF-B", "QLF"):
+    assert abs(f[name]["rmse_truth"] - f["BILIN"]["rmse_truth"]) <= 1e-9 * f["BILIN"]["rmse_truth"], (name, f[name], f["BILIN"])
+PY
+echo "ok: 1-D (double well, PF and grid filter) and 3-D (Lorenz 63) files run"
+
 # 3. Bad input.
 expect_refused() {  # expect_refused "message" args...: exactly that line, exit 2, nothing in --out
   local expected=$1; shift
