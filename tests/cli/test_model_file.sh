@@ -131,6 +131,18 @@ for name in ("SOF", "SOF-B", "QLF"):
 PY
 echo "ok: 1-D (double well, PF and grid filter) and 3-D (Lorenz 63) files run"
 
+# Same seed, same bits on every host backend and thread count (as for the built-in models).
+backends=$("$kushner" --version | sed -n 's/^available backends: \(.*\) (select.*/\1/p')
+if grep -qw openmp <<<"$backends" && grep -qw serial <<<"$backends"; then
+  det=(filter --model-file "$examples/van_der_pol.toml" --filters all --members 40 --particles 256 --T 0.2 --dt 1e-2
+       --output-points 4 --quiet --out out)
+  (cd "$work" && KUSHNER_BACKEND=serial "$kushner" "${det[@]}" && mv out det-serial)
+  (cd "$work" && KUSHNER_BACKEND=openmp OMP_NUM_THREADS=2 "$kushner" "${det[@]}" && mv out det-omp2)
+  cmp "$work/det-serial/timeseries.csv" "$work/det-omp2/timeseries.csv" ||
+    fail "van der Pol file: timeseries.csv differs between serial and 2 OpenMP threads"
+  echo "ok: a model file gives the same bits on serial and 2 OpenMP threads"
+fi
+
 # 3. Bad input.
 expect_refused() {  # expect_refused "message" args...: exactly that line, exit 2, nothing in --out
   local expected=$1; shift
