@@ -26,7 +26,7 @@ as_root() {
 }
 
 debian_packages=(g++ cmake make patch dpkg-dev libeigen3-dev libcli11-dev librandom123-dev nlohmann-json3-dev
-                 googletest libgtest-dev libbenchmark-dev python3 python3-numpy python3-matplotlib)
+                 libtomlplusplus-dev googletest libgtest-dev libbenchmark-dev python3 python3-numpy python3-matplotlib)
 
 install_packages() {
   command -v dpkg-query >/dev/null || { say "not a Debian system: install ${debian_packages[*]} by hand"; return; }
@@ -92,6 +92,7 @@ bundle() {
   [ -d "$deps/include/CLI" ] || cp -r /usr/include/CLI "$deps/include/"
   [ -d "$deps/include/Random123" ] || cp -r /usr/include/Random123 "$deps/include/"
   [ -d "$deps/include/nlohmann" ] || cp -r /usr/include/nlohmann "$deps/include/"
+  [ -d "$deps/include/toml++" ] || cp -r /usr/include/toml++ "$deps/include/"
   [ -d "$deps/googletest" ] || cp -r /usr/src/googletest "$deps/googletest"
   if [ ! -d "$deps/benchmark" ]; then
     fetch_source benchmark 'benchmark_*.orig.tar.*'

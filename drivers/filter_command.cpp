@@ -37,7 +37,7 @@ int run_estimation(const CompareOptions& options, const RunContext& context, con
   validate_run_options(options.run);
   const TimeGrid grid = make_time_grid(options.run.T, options.run.dt, options.run.output_points);
   const FilterConfig config = filter_config(options);
-  with_model(options.run.model, options.run.sets, [&](const auto& model) {
+  with_run_model(options.run.model, options.run.model_file, options.run.sets, [&](const auto& model) {
     using Model = std::decay_t<decltype(model)>;
     if constexpr (Model::discrete_time) {
       throw InputError(std::string("--model: '") + Model::name + "' is a discrete-time model; `kushner " + command +

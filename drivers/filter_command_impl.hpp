@@ -12,6 +12,7 @@
 #include "drivers/plots.hpp"
 #include "drivers/trajectory_recorder.hpp"
 #include "models/parameters.hpp"
+#include "models/registry.hpp"
 
 #include <algorithm>
 #include <string>
@@ -76,7 +77,7 @@ nlohmann::json filter_summary(const FilterReport& report, const FilterConfig& co
 template <class Model>
 std::vector<std::string> check_compare_options(const Model& model, const CompareOptions& options,
                                                const FilterConfig& config) {
-  const std::vector<std::string> filters = select_estimators<Model>(options.filters);
+  const std::vector<std::string> filters = select_estimators<Model>(options.filters, model);
   if constexpr (has_exact_reference<Model>) {
     using Grid = GridFilter<Kokkos::DefaultHostExecutionSpace, Model>;
     if (std::is_same_v<exact_reference_t<Kokkos::DefaultHostExecutionSpace, Model>, Grid> &&
@@ -114,8 +115,7 @@ nlohmann::json run_compare_command(const Model& model, const CompareOptions& opt
                                             static_cast<std::uint32_t>(options.run.seed), grid, filters, config,
                                             particle, &progress, observer);
     summary = run_metadata(context);
-    summary["model"] = {
-        {"name", Model::name}, {"state_dim", Model::state_dim}, {"parameters", parameter_values(model)}};
+    summary["model"] = model_summary(model);
     summary["members"] = options.run.members;
     summary["T"] = options.run.T;
     summary["dt"] = options.run.dt;

@@ -20,14 +20,18 @@ inline std::vector<std::string> all_filter_names() {
   return names;
 }
 
-/// "all", or a comma-separated list of names (case-sensitive), checked against what Model supports.
+/// "all", or a comma-separated list of names (case-sensitive), checked against what Model supports and, for a
+/// model with a run-time check (a --model-file polynomial), against what `model`'s coefficients allow.
 template <class Model>
-std::vector<std::string> select_filters(const std::string& list) {
+std::vector<std::string> select_filters(const std::string& list, const Model& model) {
   const std::vector<FilterSupport> support = filter_support<Model>();
+  const auto unsupported = [&](const FilterSupport& f) {
+    return f.unsupported != nullptr ? f.unsupported : runtime_filter_unsupported(model, f.name.c_str());
+  };
   std::vector<std::string> requested;
   if (list == "all") {
     for (const auto& f : support)
-      if (f.unsupported == nullptr) requested.push_back(f.name);
+      if (unsupported(f) == nullptr) requested.push_back(f.name);
     return requested;
   }
   std::string current;
@@ -48,8 +52,8 @@ std::vector<std::string> select_filters(const std::string& list) {
       for (const auto& f : support) known += (known.empty() ? "" : ", ") + f.name;
       throw InputError("--filters: unknown filter '" + name + "' (known: " + known + ", PF, EXACT, or all)");
     }
-    KUSHNER_INPUT_REQUIRE(it->unsupported == nullptr, "filter " << name << " does not support model '" << Model::name
-                                                                << "' (" << it->unsupported << ")");
+    KUSHNER_INPUT_REQUIRE(unsupported(*it) == nullptr, "filter " << name << " does not support model '" << Model::name
+                                                                 << "' (" << unsupported(*it) << ")");
   }
   std::vector<std::string> ordered;  // report order, each once
   for (const auto& f : support)
@@ -57,11 +61,18 @@ std::vector<std::string> select_filters(const std::string& list) {
   return ordered;
 }
 
+/// select_filters for a model whose support is known from its type alone.
+template <class Model>
+std::vector<std::string> select_filters(const std::string& list) {
+  static_assert(!ModelTraits<Model>::runtime_checked, "select_filters: pass the model, its coefficients decide");
+  return select_filters<Model>(list, Model{});
+}
+
 /// `--filters` with the estimators beside the bank: the bank's filters (select_filters), then "PF" (the
 /// particle filter) and "EXACT" (exact or grid filter) where named. "all" is every bank filter the model
 /// supports plus PF where it applies; EXACT only on request (the grid filter is far slower than the rest).
 template <class Model>
-std::vector<std::string> select_estimators(const std::string& list) {
+std::vector<std::string> select_estimators(const std::string& list, const Model& model) {
   std::string bank_list;
   bool particle = list == "all" && particle_filter_unsupported<Model>() == nullptr, exact = false;
   if (list == "all") {
@@ -83,6 +94,9 @@ std::vector<std::string> select_estimators(const std::string& list) {
                                                               << Model::name
                                                               << "' (no exact filter, and no grid filter above "
                                                                  "dimension 2 or for discrete time)");
+        const char* why_not = runtime_filter_unsupported(model, "EXACT");
+        KUSHNER_INPUT_REQUIRE(why_not == nullptr,
+                              "filter EXACT does not support model '" << Model::name << "' (" << why_not << ")");
         exact = true;
       } else {
         bank_list += (bank_list.empty() ? "" : ",") + current;
@@ -91,7 +105,8 @@ std::vector<std::string> select_estimators(const std::string& list) {
     }
     KUSHNER_INPUT_REQUIRE(!list.empty(), "--filters: empty list");
   }
-  std::vector<std::string> names = bank_list.empty() ? std::vector<std::string>{} : select_filters<Model>(bank_list);
+  std::vector<std::string> names =
+      bank_list.empty() ? std::vector<std::string>{} : select_filters<Model>(bank_list, model);
   if (particle) names.push_back("PF");
   if (exact) names.push_back("EXACT");
   return names;

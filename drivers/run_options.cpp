@@ -10,7 +10,11 @@ namespace kushner {
 void add_run_options(CLI::App& app, RunOptions& o) {
   // A value given twice (config file, then command line) takes the last one.
   app.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
-  app.add_option("--model", o.model, "model name (see `kushner models`)")->capture_default_str();
+  app.add_option("--model", o.model, "model name (see `kushner models`)")
+      ->capture_default_str()
+      ->each([&o](const std::string&) { o.model_given = true; });
+  app.add_option("--model-file", o.model_file,
+                 "a polynomial model from a TOML file instead of --model (README, \"Models\")");
   app.add_option("--set", o.sets, "model parameter, key=value (repeatable; matrices as 1,0;0,1)")
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   app.add_option("--members", o.members, "ensemble members M")->capture_default_str();
@@ -24,6 +28,8 @@ void add_run_options(CLI::App& app, RunOptions& o) {
 }
 
 void validate_run_options(const RunOptions& o) {
+  KUSHNER_INPUT_REQUIRE(!(o.model_given && !o.model_file.empty()),
+                        "--model-file: give either --model or --model-file, not both (the file defines the model)");
   KUSHNER_INPUT_REQUIRE(o.members > 0, "--members: must be positive (got " << o.members << ")");
   KUSHNER_INPUT_REQUIRE(o.members <= std::numeric_limits<std::int32_t>::max(),
                         "--members: at most " << std::numeric_limits<std::int32_t>::max() << " (got " << o.members << ")");

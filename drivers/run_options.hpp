@@ -11,6 +11,8 @@ namespace kushner {
 
 struct RunOptions {
   std::string model = "sine";
+  bool model_given = false;       // --model was on the command line (or in --config)
+  std::string model_file;         // --model-file FILE: a polynomial model (models/model_file.hpp)
   std::vector<std::string> sets;  // "key=value"
   long members = 1000;
   double T = 10.0;
@@ -22,7 +24,7 @@ struct RunOptions {
   std::string config;  // --config FILE, already expanded into the fields above by main()
 };
 
-/// --model, --set, --members, --T, --dt, --seed, --out, --output-points, --quiet, --config.
+/// --model, --model-file, --set, --members, --T, --dt, --seed, --out, --output-points, --quiet, --config.
 void add_run_options(CLI::App& app, RunOptions& options);
 
 /// InputError (one line naming the option) for any value a run cannot use.

@@ -29,7 +29,7 @@ std::string timeseries_csv(const MomentSeries& series, const RunContext& context
 int run_simulate(const RunOptions& options, const RunContext& context) {
   validate_run_options(options);
   const TimeGrid grid = make_time_grid(options.T, options.dt, options.output_points);
-  with_model(options.model, options.sets, [&](const auto& model) {
+  with_run_model(options.model, options.model_file, options.sets, [&](const auto& model) {
     using Model = std::decay_t<decltype(model)>;
     const OutputDirectory out(options.out, "--out");
     KokkosSession kokkos;
@@ -38,7 +38,7 @@ int run_simulate(const RunOptions& options, const RunContext& context) {
       const MomentSeries series = simulate_ensemble(space, model, options.members,
                                                     static_cast<std::uint32_t>(options.seed), grid, &progress);
       nlohmann::json summary = run_metadata(context);
-      summary["model"] = {{"name", Model::name}, {"state_dim", Model::state_dim}, {"parameters", parameter_values(model)}};
+      summary["model"] = model_summary(model);
       summary["members"] = options.members;
       summary["T"] = options.T;
       summary["dt"] = options.dt;

@@ -41,6 +41,17 @@ struct PowerPolynomial {
   }
 };
 
+/// The terms of p up to degree D (all of p when its degree is at most D). Only for a p whose higher
+/// coefficients are known to vanish (a run-time polynomial checked by its filter_unsupported()).
+template <int D, int N, int Degree>
+KOKKOS_INLINE_FUNCTION PowerPolynomial<N, (D < Degree ? D : Degree)> truncated(const PowerPolynomial<N, Degree>& p) {
+  constexpr int degree = D < Degree ? D : Degree;
+  PowerPolynomial<N, degree> r;
+  r.a0 = p.a0;
+  for (int k = 0; k <= degree; ++k) r.coefficient[k] = p.coefficient[k];
+  return r;
+}
+
 /// One bilinear term c x_i x_j of component k (i == j allowed).
 struct QuadraticTerm {
   int k, i, j;

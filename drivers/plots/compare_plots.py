@@ -73,7 +73,7 @@ def plot_estimates(directory, summary, rows, colors):
                     ls=":", label="truth")
         ax.set_ylabel(f"x{c}")
         ax.grid(alpha=0.3)
-    axes[0, 0].set_title(f"{summary['model']['name']}: member {member}, estimates and the particle filter's 5-95% band")
+    axes[0, 0].set_title(f"{model_name(summary)}: member {member}, estimates and the particle filter's 5-95% band")
     axes[-1, 0].set_xlabel("t")
     axes[0, 0].legend(fontsize=7, ncol=4, loc="upper right")
     save(fig, directory, "estimates")
@@ -147,14 +147,24 @@ def fmt(value, se=None):
     return f"{value:.4g} ± {se:.2g}" if se is not None else f"{value:.4g}"
 
 
+def model_name(summary):
+    """The model's name; for a --model-file model, the file's own name (or path) after it."""
+    model = summary["model"]
+    if "file" in model:
+        return f"{model['name']} ({model.get('label', model['file'])})"
+    return model["name"]
+
+
 def write_report(directory, summary, figures):
     backend = summary.get("backend", {})
     where = backend.get("device") or f"{backend.get('threads', '?')} threads"
-    lines = [f"# kushner compare: {summary['model']['name']}", "",
+    lines = [f"# kushner compare: {model_name(summary)}", "",
              f"- command: `{summary['command']}`",
              f"- seed {summary['seed']}, kushner {summary['version']} (git {summary.get('git', '?')}), "
              f"backend {backend.get('name', '?')} ({where}), Kokkos {backend.get('kokkos', '?')}",
              f"- members {summary['members']}, T = {summary['T']}, dt = {summary['dt']}"]
+    if "file" in summary["model"]:
+        lines.append(f"- model file: `{summary['model']['file']}` (coefficients in summary.json)")
     ref = summary.get("reference")
     if ref:
         if ref.get("kind") == "particle filter":

@@ -43,7 +43,9 @@ struct MixedFilter {
 
   KOKKOS_INLINE_FUNCTION static Vec<n> polynomial_mean(const Model& model, double t, const Vec<n>& m,
                                                        const Mat<n, n>& P) {
-    if constexpr (ModelTraits<Model>::quadratic_polynomial)
+    if constexpr (ModelTraits<Model>::runtime_checked)  // a run-time polynomial: its own exact E_N[f]
+      return model.gaussian_drift(t, m, P).mean;
+    else if constexpr (ModelTraits<Model>::quadratic_polynomial)
       return gaussian_drift(drift_quadratic_polynomial(model, t), m, P).mean;
     else
       return gaussian_drift(drift_power_polynomial(model, t), m, P).mean;

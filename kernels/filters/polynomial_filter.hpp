@@ -20,7 +20,9 @@ constexpr const char* polynomial_filter_unsupported() {
   if (!T::power_polynomial)
     return T::quadratic_polynomial ? "drift has cross terms x_i x_j, not componentwise powers (BILIN handles them)"
                                    : "drift is not polynomial";
-  if (T::power_degree() > Degree) return Degree == 3 ? "drift has degree above 3" : "drift has degree above 4";
+  // A run-time polynomial's degree is checked per file (filter_unsupported); its type allows degree 4.
+  if (T::power_degree() > Degree && !T::runtime_checked)
+    return Degree == 3 ? "drift has degree above 3" : "drift has degree above 4";
   if (!T::linear_observation) return "observation is not linear";
   return nullptr;
 }
@@ -37,7 +39,7 @@ struct PolynomialStep {
     Vec<p> weighted_innovation;
     if (!kalman_update(observation_linearization(model, in.t, m), in, m, P, weighted_innovation))
       return Status::not_positive_definite;
-    const GaussianDrift<n> g = gaussian_drift(drift_power_polynomial(model, in.t), m, P);
+    const GaussianDrift<n> g = gaussian_drift(truncated<Degree>(drift_power_polynomial(model, in.t)), m, P);
     euler_predict(DriftLinearization<n>{g.mean, g.jacobian, noise_intensity(model.diffusion(in.t, m))}, in.dt, m, P);
     return Status::ok;
   }

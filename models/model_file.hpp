@@ -1,0 +1,152 @@
+#pragma once
+// `--model-file FILE`: the polynomial model (models/polynomial_model.hpp) a model file describes
+// (models/polynomial_spec.hpp: the format), its record in summary.json, and the dispatch on its dimension.
+#include "kernels/errors.hpp"
+#include "models/model_checks.hpp"
+#include "models/parameters.hpp"
+#include "models/polynomial_model.hpp"
+#include "models/polynomial_spec.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace kushner {
+
+/// check_covariance for a matrix of the file: InputError "path: key: ...".
+template <int N>
+void check_file_covariance(const PolynomialModelSpec& spec, const std::string& key, const Mat<N, N>& m,
+                           bool allow_singular) {
+  try {
+    check_covariance(key, m, allow_singular);
+  } catch (const InputError& e) {
+    throw InputError(spec.path + ": " + e.what());
+  }
+}
+
+/// The model of a checked file; InputError "path: key: ..." unless R R^T is positive definite and x0_cov,
+/// prior_cov are covariances.
+template <int N>
+PolynomialModel<N> make_polynomial_model(const PolynomialModelSpec& spec, const PolynomialModelSource* source) {
+  KUSHNER_REQUIRE(spec.n == N, "model file has state_dim " << spec.n << ", not " << N);
+  PolynomialModel<N> model;
+  model.source = source;
+  model.obs_rows = spec.p;
+  model.noise_columns = spec.q;
+  for (int i = 0; i < N; ++i) {
+    model.a0[i] = spec.a0[i];
+    model.x0_mean[i] = spec.x0_mean[i];
+    model.prior_mean[i] = spec.prior_mean[i];
+    for (int j = 0; j < N; ++j) {
+      model.a1(i, j) = spec.a1[i * N + j];
+      model.x0_cov(i, j) = spec.x0_cov[i * N + j];
+      model.prior_cov(i, j) = spec.prior_cov[i * N + j];
+    }
+    for (int t = 0; t < PolynomialModel<N>::num_monomials; ++t)
+      model.coefficient[i][t] = spec.monomial[i * PolynomialModel<N>::num_monomials + t];
+    for (int j = 0; j < spec.q; ++j) model.b(i, j) = spec.b[i * spec.q + j];
+  }
+  for (int i = 0; i < spec.p; ++i) {
+    model.c0[i] = spec.c0[i];
+    for (int j = 0; j < N; ++j) model.C(i, j) = spec.C[i * N + j];
+    for (int j = 0; j < spec.p; ++j) model.R(i, j) = spec.R[i * spec.p + j];
+  }
+  // R is the file's p x p block with the identity below it: R R^T is positive definite when the block's is,
+  // and the pivot numbers are the block's.
+  check_file_covariance(spec, "observation.R: R R^T", model.R * transpose(model.R), /*allow_singular=*/false);
+  check_file_covariance(spec, "initial.x0_cov", model.x0_cov, /*allow_singular=*/true);
+  check_file_covariance(spec, "initial.prior_cov", model.prior_cov, /*allow_singular=*/true);
+  return model;
+}
+
+/// What summary.json records of a polynomial model: its file, and the coefficients as they run (drift as
+/// a0, a1 and the nonzero terms of degree 2..4 in the file's [[drift.terms]] form; b, C, R in the file's
+/// shapes).
+template <int N>
+nlohmann::json polynomial_model_json(const PolynomialModel<N>& model) {
+  const int p = model.obs_rows, q = model.noise_columns;
+  auto matrix = [](const auto& m, int rows, int cols) {
+    std::vector<std::vector<double>> r(rows, std::vector<double>(cols));
+    for (int i = 0; i < rows; ++i)
+      for (int j = 0; j < cols; ++j) r[i][j] = m(i, j);
+    return r;
+  };
+  nlohmann::json terms = nlohmann::json::array();
+  for (int t = 0; t < PolynomialModel<N>::num_monomials; ++t) {
+    const Monomial mono = polynomial_monomial(N, t);
+    std::vector<int> powers(N, 0);
+    for (int r = 0; r < mono.degree; ++r) ++powers[mono.var[r]];
+    for (int k = 0; k < N; ++k)
+      if (model.coefficient[k][t] != 0.0)
+        terms.push_back({{"component", k + 1}, {"powers", powers}, {"coefficient", model.coefficient[k][t]}});
+  }
+  nlohmann::json j = {{"state_dim", N},
+                      {"obs_dim", p},
+                      {"noise_dim", q},
+                      {"drift",
+                       {{"a0", std::vector<double>(model.a0.v, model.a0.v + N)},
+                        {"a1", matrix(model.a1, N, N)},
+                        {"terms", terms},
+                        {"degree", model.degree()}}},
+                      {"diffusion", {{"b", matrix(model.b, N, q)}}},
+                      {"observation",
+                       {{"c0", std::vector<double>(model.c0.v, model.c0.v + p)},
+                        {"C", matrix(model.C, p, N)},
+                        {"R", matrix(model.R, p, p)}}}};
+  if (model.source != nullptr) {
+    j["file"] = model.source->path;
+    if (*model.source->label) j["label"] = model.source->label;
+    if (*model.source->description) j["description"] = model.source->description;
+  }
+  return j;
+}
+
+/// Reads the model file `path`, applies `sets` ("key=value": the initial law, x0_mean, x0_cov, prior_mean,
+/// prior_cov; the rest is edited in the file), validates the model and calls f(model) with a
+/// PolynomialModel<state_dim>. InputError for a bad file or assignment.
+template <class F>
+void with_model_file(const std::string& path, const std::vector<std::string>& sets, F&& f) {
+  const PolynomialModelSpec spec = read_polynomial_model_file(path);
+  const PolynomialModelSource source{spec.path.c_str(), spec.label.c_str(), spec.description.c_str()};
+  std::vector<std::pair<std::string, std::string>> assignments;
+  for (const auto& s : sets) {
+    auto kv = split_assignment(s);
+    KUSHNER_INPUT_REQUIRE(kv.first != "dim",
+                          "--set dim: a --model-file model has the file's state_dim (" << spec.n << ")");
+    assignments.push_back(std::move(kv));
+  }
+  auto run = [&](auto* tag) {
+    using Model = std::remove_pointer_t<decltype(tag)>;
+    Model model = make_polynomial_model<Model::state_dim>(spec, &source);
+    ParameterRecorder settable;
+    model.parameters(settable);
+    std::string names;
+    for (const auto& e : settable.entries()) names += (names.empty() ? "" : ", ") + e.name;
+    for (const auto& assignment : assignments) {
+      bool known = false;
+      for (const auto& e : settable.entries()) known = known || e.name == assignment.first;
+      KUSHNER_INPUT_REQUIRE(known, "--set " << assignment.first << ": a --model-file model takes " << names
+                                            << " (the other coefficients are edited in " << path << ")");
+    }
+    apply_parameters(model, assignments);
+    validate_model(model);
+    f(model);
+  };
+  switch (spec.n) {
+    case 1:
+      run(static_cast<PolynomialModel<1>*>(nullptr));
+      break;
+    case 2:
+      run(static_cast<PolynomialModel<2>*>(nullptr));
+      break;
+    case 3:
+      run(static_cast<PolynomialModel<3>*>(nullptr));
+      break;
+    default:
+      KUSHNER_REQUIRE(false, "read_polynomial_model_file let state_dim " << spec.n << " through");
+  }
+}
+
+}  // namespace kushner
