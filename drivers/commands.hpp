@@ -2,6 +2,7 @@
 // The subcommands of `kushner`. Each validates all its input before opening any output and throws
 // InputError for bad input; main() turns that into one line on stderr and exit code 2.
 #include "drivers/filter_options.hpp"
+#include "drivers/reproduce/reproduce_options.hpp"
 #include "drivers/run_metadata.hpp"
 #include "drivers/run_options.hpp"
 
@@ -16,6 +17,10 @@ int run_filter(const FilterOptions& options, const RunContext& context);
 /// `kushner compare`: `filter` with the particle reference by default, plus trajectories, density
 /// snapshots, plots and report.md.
 int run_compare(const CompareOptions& options, const RunContext& context);
+
+/// `kushner reproduce NAME`: a worked example of the seeds run by the engine, with compare's artefacts and a
+/// table of the paper's numbers next to ours (reproduction.csv, reproduction.md, printed on stdout).
+int run_reproduce(const ReproduceOptions& options, const RunContext& context);
 
 /// `kushner filters`: every filter and the models it supports (or why not).
 int run_filters_list(bool json);

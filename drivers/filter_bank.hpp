@@ -48,7 +48,9 @@ struct FilterScores {
   long diverged = 0, not_positive_definite = 0, non_finite = 0;  // among members whose truth did not escape
 };
 
-template <class ExecSpace, class Model>
+/// `TruthModel`: the truths' model type, Model unless the truths follow another system of the same dimensions
+/// (kernels/filters/filter_bank_step.hpp).
+template <class ExecSpace, class Model, class TruthModel = Model>
 class FilterBank {
  public:
   using MemSpace = typename ExecSpace::memory_space;
@@ -60,7 +62,7 @@ class FilterBank {
   template <class... Filters>
   struct Kernels<std::tuple<Filters...>> {
     using Slots = FilterSlots<MemSpace, Filters...>;
-    using Step = FilterBankStep<Model, MemSpace, Filters...>;
+    using Step = FilterBankStep<Model, TruthModel, MemSpace, Filters...>;
     using Initial = FilterBankInitialScore<Model, MemSpace, Filters...>;
     using Reference = FilterBankReferenceScore<Model, MemSpace, BankVector<MemSpace>, Filters...>;
   };
@@ -68,8 +70,9 @@ class FilterBank {
 
  public:
   /// `filters`: names from select_filters<Model>() (supported, report order). The truths follow truth_model,
-  /// the filters filter_model (the same in a run; tests set them apart to show that a test can fail).
-  FilterBank(const ExecSpace& space, const Model& truth_model, const Model& filter_model, long members,
+  /// the filters filter_model (the same in most runs; tests set them apart to show that a test can fail, and
+  /// `kushner reproduce` runs filters of a Taylor model on the system it approximates).
+  FilterBank(const ExecSpace& space, const TruthModel& truth_model, const Model& filter_model, long members,
              std::uint32_t seed, const std::vector<std::string>& filters, const FilterConfig& config)
       : space_(space),
         truth_model_(truth_model),
@@ -124,8 +127,8 @@ class FilterBank {
   /// Step k, over [k dt, (k + 1) dt]; `record`: (k + 1) dt is an output time.
   void step(long k, double dt, bool record) {
     const auto step = static_cast<std::uint32_t>(k);
-    typename K::Step kernel{EulerMaruyamaTruthStep<Model, MemSpace>{truth_model_, truths_.state(),
-                                                                    truths_.observations(), k * dt, dt, seed_, step},
+    typename K::Step kernel{EulerMaruyamaTruthStep<TruthModel, MemSpace>{
+                                truth_model_, truths_.state(), truths_.observations(), k * dt, dt, seed_, step},
                             filter_model_, truth_status_, slots_, record};
     parallel_for_members("kushner::filter_bank_step", space_, members_, kernel);
     bool reference_stepped = false;
@@ -138,7 +141,7 @@ class FilterBank {
     for (auto& e : estimators_) score_estimator(e, record);
   }
 
-  const TruthBank<ExecSpace, Model>& truths() const { return truths_; }
+  const TruthBank<ExecSpace, TruthModel>& truths() const { return truths_; }
   /// (member): non_finite once the member's truth escaped to infinity.
   const BankScalar<Status, MemSpace>& truth_status() const { return truth_status_; }
 
@@ -291,10 +294,11 @@ class FilterBank {
   }
 
   ExecSpace space_;
-  Model truth_model_, filter_model_;
+  TruthModel truth_model_;
+  Model filter_model_;
   long members_;
   std::uint32_t seed_;
-  TruthBank<ExecSpace, Model> truths_;
+  TruthBank<ExecSpace, TruthModel> truths_;
   BankScalar<Status, MemSpace> truth_status_;
   typename K::Slots slots_;
   ReferenceEstimator<MemSpace>* reference_ = nullptr;

@@ -15,7 +15,9 @@
 #include "models/registry.hpp"
 
 #include <algorithm>
+#include <functional>
 #include <string>
+#include <type_traits>
 
 namespace kushner {
 
@@ -96,9 +98,34 @@ std::vector<std::string> check_compare_options(const Model& model, const Compare
   return filters;
 }
 
-template <class Model>
-nlohmann::json run_compare_command(const Model& model, const CompareOptions& options, const FilterConfig& config,
-                                   const TimeGrid& grid, const RunContext& context, const OutputDirectory& out) {
+/// Draws the plots and report.md from what `out` holds (summary.json first) and records in `summary` what they
+/// wrote (or why not); rewrites summary.json.
+inline void add_plots(const OutputDirectory& out, nlohmann::json& summary) {
+  const PlotResult plots = write_plots_and_report(out);
+  summary["plots"] = plots.ok;
+  if (plots.ok)
+    for (const auto& file : plots.files) summary["files"].push_back(file);
+  else
+    summary["plots_error"] = plots.message;
+  out.write("summary.json", summary.dump(2) + "\n");
+}
+
+/// No estimators beside the bank other than those named in --filters.
+struct NoExtraEstimators {
+  template <class ExecSpace>
+  ExtraEstimators<ExecSpace> operator()(const ExecSpace&) const {
+    return {};
+  }
+};
+
+/// run_compare_command with the truths following `truth_model` (same dimensions as `model`, e.g. the system a
+/// Taylor model approximates, or `model` with a deterministic observation noise) and the estimators that
+/// make_extras(space) returns run beside the bank (run_filters). summary.json then also records the truths'
+/// model under "truth".
+template <class Model, class TruthModel, class MakeExtras = NoExtraEstimators>
+nlohmann::json run_compare_with_truth(const TruthModel& truth_model, const Model& model, const CompareOptions& options,
+                                      const FilterConfig& config, const TimeGrid& grid, const RunContext& context,
+                                      const OutputDirectory& out, const MakeExtras& make_extras = {}) {
   const std::vector<std::string> filters = check_compare_options<Model>(model, options, config);
   const ParticleSettings particle = particle_settings(options);
   std::vector<double> density_times = options.density_times;
@@ -109,13 +136,19 @@ nlohmann::json run_compare_command(const Model& model, const CompareOptions& opt
     TrajectoryRecorder<ExecSpace, Model> recorder(options.trajectory_members, options.run.members, density_times);
     const bool asre = std::find(filters.begin(), filters.end(), "ASRE") != filters.end();
     Progress progress(options.plots ? "compare" : "filter", grid.steps * (asre ? 3 : 1), !options.run.quiet);
-    OutputObserver<ExecSpace, Model> observer;
+    OutputObserver<ExecSpace, Model, TruthModel> observer;
     if (!options.trajectory_members.empty()) observer = std::ref(recorder);
-    const FilterReport report = run_filters(space, model, model, options.run.members,
-                                            static_cast<std::uint32_t>(options.run.seed), grid, filters, config,
-                                            particle, &progress, observer);
+    const FilterReport report =
+        run_filters(space, truth_model, model, options.run.members, static_cast<std::uint32_t>(options.run.seed), grid,
+                    filters, config, particle, &progress, observer, make_extras(space));
     summary = run_metadata(context);
     summary["model"] = model_summary(model);
+    if constexpr (!std::is_same_v<TruthModel, Model>)
+      summary["truth"] = {
+          {"name", TruthModel::name},
+          {"parameters", parameter_values(truth_model)},
+          {"observation_noise",
+           has_deterministic_observation_noise<TruthModel> ? "deterministic: sin t on every component" : "Brownian"}};
     summary["members"] = options.run.members;
     summary["T"] = options.run.T;
     summary["dt"] = options.run.dt;
@@ -140,16 +173,14 @@ nlohmann::json run_compare_command(const Model& model, const CompareOptions& opt
     summary["files"] = files;
     out.write("summary.json", summary.dump(2) + "\n");
   });
-  if (options.plots) {  // the plots read summary.json; it then records what they wrote
-    const PlotResult plots = write_plots_and_report(out);
-    summary["plots"] = plots.ok;
-    if (plots.ok)
-      for (const auto& file : plots.files) summary["files"].push_back(file);
-    else
-      summary["plots_error"] = plots.message;
-    out.write("summary.json", summary.dump(2) + "\n");
-  }
+  if (options.plots) add_plots(out, summary);  // the plots read summary.json; it then records what they wrote
   return summary;
+}
+
+template <class Model>
+nlohmann::json run_compare_command(const Model& model, const CompareOptions& options, const FilterConfig& config,
+                                   const TimeGrid& grid, const RunContext& context, const OutputDirectory& out) {
+  return run_compare_with_truth(model, model, options, config, grid, context, out);
 }
 
 }  // namespace kushner

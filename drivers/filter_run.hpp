@@ -52,22 +52,27 @@ inline bool is_outside_estimator(const std::string& name) { return name == "PF" 
 
 /// Called at t = 0 and at every output time with the bank and the outside estimators (PF, EXACT), e.g. to
 /// record chosen members' trajectories.
-template <class ExecSpace, class Model>
-using OutputObserver = std::function<void(
-    double t, const FilterBank<ExecSpace, Model>&,
-    const std::vector<const ReferenceEstimator<typename ExecSpace::memory_space>*>&)>;
+template <class ExecSpace, class Model, class TruthModel = Model>
+using OutputObserver =
+    std::function<void(double t, const FilterBank<ExecSpace, Model, TruthModel>&,
+                       const std::vector<const ReferenceEstimator<typename ExecSpace::memory_space>*>&)>;
+
+/// Estimators a caller adds beside the bank (e.g. `kushner reproduce`'s exact quadrature for a deterministic
+/// model, or a paper's printed variant of a filter); run_filters owns them from then on.
+template <class ExecSpace>
+using ExtraEstimators = std::vector<std::unique_ptr<ReferenceEstimator<typename ExecSpace::memory_space>>>;
 
 namespace detail {
 
 /// One pass of the truths with ASRE alone, member `i` iterated iterations[i] times; marks in `first` each
 /// member's first iterate j >= 1 (among those run) with max_t |m^[j] - m^[j-1]| < tolerance, and in
 /// `diverged` the members whose iterates (or truth) did not stay finite.
-template <class ExecSpace, class Model>
-void asre_pass(const ExecSpace& space, const Model& truth_model, const Model& filter_model, long members,
+template <class ExecSpace, class Model, class TruthModel>
+void asre_pass(const ExecSpace& space, const TruthModel& truth_model, const Model& filter_model, long members,
                std::uint32_t seed, const TimeGrid& grid, FilterConfig config, const std::vector<int>& iterations,
                std::vector<int>& first, std::vector<char>& diverged, Progress* progress, long progress_base) {
   config.asre_iterations = iterations;
-  FilterBank<ExecSpace, Model> bank(space, truth_model, filter_model, members, seed, {"ASRE"}, config);
+  FilterBank<ExecSpace, Model, TruthModel> bank(space, truth_model, filter_model, members, seed, {"ASRE"}, config);
   for (long k = 0; k < grid.steps; ++k) {
     bank.step(k, grid.dt, false);
     if (progress) progress->update(progress_base + k + 1);
@@ -95,8 +100,8 @@ void asre_pass(const ExecSpace& space, const Model& truth_model, const Model& fi
 /// Iterates do not depend on how many follow them, so this runs the truths with ASRE alone twice: every
 /// member iterated `asre_first_round` times, then only the members still unconverged up to max_iterations
 /// (the others iterate 0 times there). `progress` advances by 2 grid.steps.
-template <class ExecSpace, class Model>
-AsreIterations asre_iterations(const ExecSpace& space, const Model& truth_model, const Model& filter_model,
+template <class ExecSpace, class Model, class TruthModel>
+AsreIterations asre_iterations(const ExecSpace& space, const TruthModel& truth_model, const Model& filter_model,
                                long members, std::uint32_t seed, const TimeGrid& grid, const FilterConfig& config,
                                Progress* progress) {
   constexpr int asre_first_round = 10;  // most members of the seed models converge within it at tolerance 1e-6
@@ -134,14 +139,16 @@ AsreIterations asre_iterations(const ExecSpace& space, const Model& truth_model,
 }
 
 /// Runs the filters `filters` (from select_estimators<Model>: bank filters, then "PF" and/or "EXACT") over
-/// `grid`. The truths follow truth_model, the filters filter_model. With PF or EXACT, every other estimate is
-/// also scored against the reference's mean (rmse_ref). `progress` counts steps of all passes: 3 grid.steps
-/// when ASRE is selected, else grid.steps.
-template <class ExecSpace, class Model>
-FilterReport run_filters(const ExecSpace& space, const Model& truth_model, const Model& filter_model, long members,
+/// `grid`, and the `extra` estimators after them (reported after them, in their order). The truths follow
+/// truth_model, the filters filter_model. With PF, EXACT or an extra estimator, every other estimate is also
+/// scored against the reference's mean (rmse_ref): the first of PF, EXACT, extra[0], ... `progress` counts
+/// steps of all passes: 3 grid.steps when ASRE is selected, else grid.steps.
+template <class ExecSpace, class Model, class TruthModel>
+FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, const Model& filter_model, long members,
                          std::uint32_t seed, const TimeGrid& grid, const std::vector<std::string>& filters,
                          FilterConfig config, const ParticleSettings& particle = {}, Progress* progress = nullptr,
-                         const OutputObserver<ExecSpace, Model>& observer = {}) {
+                         const OutputObserver<ExecSpace, Model, TruthModel>& observer = {},
+                         ExtraEstimators<ExecSpace> extra = {}) {
   using MemSpace = typename ExecSpace::memory_space;
   FilterReport report;
   report.filters = filters;
@@ -160,11 +167,17 @@ FilterReport run_filters(const ExecSpace& space, const Model& truth_model, const
   }
   KUSHNER_REQUIRE(bank_filters.size() + outside.size() == filters.size(),
                   "run_filters: PF or EXACT named for a model that has none (select_estimators refuses it)");
+  for (auto& e : extra) {
+    KUSHNER_REQUIRE(e && std::find(filters.begin(), filters.end(), e->name()) == filters.end(),
+                    "run_filters: an extra estimator is null or named like a selected one");
+    report.filters.push_back(e->name());
+    outside.push_back(std::move(e));
+  }
   if (std::find(filters.begin(), filters.end(), "ASRE") != filters.end()) {
     report.asre = asre_iterations(space, truth_model, filter_model, members, seed, grid, config, progress);
     config.asre_iterations = report.asre.per_member;
   }
-  FilterBank<ExecSpace, Model> bank(space, truth_model, filter_model, members, seed, bank_filters, config);
+  FilterBank<ExecSpace, Model, TruthModel> bank(space, truth_model, filter_model, members, seed, bank_filters, config);
   std::vector<const ReferenceEstimator<MemSpace>*> outside_view;
   if (!outside.empty()) {
     bank.set_reference(outside.front().get());  // PF comes before EXACT
@@ -178,7 +191,7 @@ FilterReport run_filters(const ExecSpace& space, const Model& truth_model, const
   auto record = [&](double t) {
     report.times.push_back(t);
     report.series.emplace_back();
-    for (const auto& name : filters) report.series.back().push_back(bank.snapshot(name));
+    for (const auto& name : report.filters) report.series.back().push_back(bank.snapshot(name));
     if (observer) observer(t, bank, outside_view);
   };
   record(0.0);
@@ -194,7 +207,7 @@ FilterReport run_filters(const ExecSpace& space, const Model& truth_model, const
     if (progress) progress->update(progress_base + k + 1);
   }
   space.fence();
-  for (const auto& name : filters) report.scores.push_back(bank.scores(name, grid.steps + 1));
+  for (const auto& name : report.filters) report.scores.push_back(bank.scores(name, grid.steps + 1));
   for (const auto& e : outside) report.estimators[e->name()] = e->describe();
   report.truths_escaped = bank.truths_escaped();
   return report;

@@ -28,6 +28,7 @@ struct Options {
   RunOptions simulate;
   FilterOptions filter;
   CompareOptions compare = compare_defaults();
+  ReproduceOptions reproduce;
   bool models_json = false;
   bool filters_json = false;
 };
@@ -44,6 +45,10 @@ std::unique_ptr<CLI::App> make_app(Options& o) {
   add_compare_options(*app->add_subcommand("compare", "filters against the particle reference, with plots and a "
                                                       "report (the main job; defaults: the sine model)"),
                       o.compare);
+  add_reproduce_options(*app->add_subcommand("reproduce",
+                                             "run a worked example of the seed papers and put the "
+                                             "paper's numbers next to ours"),
+                        o.reproduce);
   app->add_subcommand("models", "list the built-in models and their parameters")
       ->add_flag("--json", o.models_json, "as JSON");
   app->add_subcommand("filters", "list the filters and the models each supports")
@@ -97,6 +102,10 @@ int run(int argc, char** argv) {
     context.seed = static_cast<std::uint32_t>(o.compare.run.seed);
     context.backend = selected_backend();
     return run_compare(o.compare, context);
+  }
+  if (app->got_subcommand("reproduce")) {
+    context.backend = selected_backend();
+    return run_reproduce(o.reproduce, context);
   }
   if (app->got_subcommand("simulate")) {
     context.seed = static_cast<std::uint32_t>(o.simulate.seed);

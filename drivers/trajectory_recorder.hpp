@@ -40,7 +40,8 @@ class TrajectoryRecorder {
     density_ = "t,member,x,series,density\n";
   }
 
-  void operator()(double t, const FilterBank<ExecSpace, Model>& bank,
+  template <class TruthModel>
+  void operator()(double t, const FilterBank<ExecSpace, Model, TruthModel>& bank,
                   const std::vector<const ReferenceEstimator<MemSpace>*>& outside) {
     std::vector<int> members(members_.begin(), members_.end());
     if (members.empty()) return;
@@ -102,7 +103,8 @@ class TrajectoryRecorder {
     }
   }
 
-  void add_density(double t, int member, const FilterBank<ExecSpace, Model>& bank,
+  template <class TruthModel>
+  void add_density(double t, int member, const FilterBank<ExecSpace, Model, TruthModel>& bank,
                    const std::vector<const ReferenceEstimator<MemSpace>*>& outside,
                    const ReferenceEstimator<MemSpace>& pf, const ParticleSnapshot& snapshot) {
     density_taken_ = true;

@@ -58,7 +58,10 @@ EnsembleMoments ensemble_moments(const ExecSpace& space, const View& x) {
   const int members = static_cast<int>(x.extent(0));
   const int columns = static_cast<int>(x.extent(1));
   const int num_blocks = (members + moment_block_size - 1) / moment_block_size;
-  Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> blocks("kushner::moment_blocks", num_blocks, 1 + 2 * columns);
+  // Zero-filled on `space`, not on the default execution space: with a few members on Serial, an OpenMP
+  // fork and join per call cost more than the moments (kushner reproduce's one-member runs).
+  Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> blocks(Kokkos::view_alloc(space, "kushner::moment_blocks"),
+                                                              num_blocks, 1 + 2 * columns);
   Kokkos::parallel_for("kushner::block_moments", Kokkos::RangePolicy<ExecSpace>(space, 0, num_blocks),
                        BlockMoments<MemSpace>{x, blocks});
   space.fence();

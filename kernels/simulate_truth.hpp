@@ -10,8 +10,24 @@
 #include <Kokkos_Core.hpp>
 
 #include <cstdint>
+#include <type_traits>
+#include <utility>
 
 namespace kushner {
+
+namespace detail {
+template <class Model, class = void>
+struct has_observation_noise_increment : std::false_type {};
+template <class Model>
+struct has_observation_noise_increment<
+    Model, std::void_t<decltype(std::declval<const Model&>().observation_noise_increment(0.0, 0.0))>> : std::true_type {
+};
+}  // namespace detail
+
+/// Whether Model's observation noise is a given deterministic path (models/sine_observation_noise.hpp): the
+/// truths then take dv = model.observation_noise_increment(t, dt) instead of a Brownian increment.
+template <class Model>
+constexpr bool has_deterministic_observation_noise = detail::has_observation_noise_increment<Model>::value;
 
 /// x(member) = mean + root z, z standard normal from Stream::truth_initial (root: any square root of the
 /// initial covariance, computed on the host, so that a singular covariance (fixed start) is allowed).
@@ -36,7 +52,8 @@ void initialize_gaussian(const ExecSpace& space, const BankVector<MemSpace>& x, 
 }
 
 /// One Euler-Maruyama step of every member over [t, t + dt]:
-///   dy = h(t, x) dt + R dv,   x <- x + f(t, x, u) dt + G(t, x) dw,   dw, dv ~ N(0, dt I).
+///   dy = h(t, x) dt + R dv,   x <- x + f(t, x, u) dt + G(t, x) dw,   dw, dv ~ N(0, dt I),
+/// or dv = model.observation_noise_increment(t, dt) where the model's observation noise is a deterministic path.
 template <class Model, class MemSpace>
 struct EulerMaruyamaTruthStep {
   Model model;
@@ -50,7 +67,11 @@ struct EulerMaruyamaTruthStep {
     const typename Model::Control u = Model::Control::zero();
     const double sqrt_dt = math::sqrt(dt);
     const Vec<q> dw = normal_vector<q>(RngKey{seed, Stream::process_noise}, member, 0, step) * sqrt_dt;
-    const Vec<p> dv = normal_vector<p>(RngKey{seed, Stream::observation_noise}, member, 0, step) * sqrt_dt;
+    Vec<p> dv;
+    if constexpr (has_deterministic_observation_noise<Model>)
+      dv = model.observation_noise_increment(t, dt);
+    else
+      dv = normal_vector<p>(RngKey{seed, Stream::observation_noise}, member, 0, step) * sqrt_dt;
     store(dy, member, model.observation(t, xm) * dt + model.observation_noise(t) * dv);
     store(x, member, xm + model.drift(t, xm, u) * dt + model.diffusion(t, xm) * dw);
   }

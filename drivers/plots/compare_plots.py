@@ -4,8 +4,9 @@
 usage: compare_plots.py DIR
 
 Reads DIR/summary.json, DIR/timeseries.csv, DIR/trajectories.csv and (1-D models) DIR/density.csv, as written
-by `kushner compare`, and writes PNG and SVG figures plus DIR/report.md. Figures are written through a
-temporary name and renamed, like every kushner output.
+by `kushner compare`, and writes PNG and SVG figures plus DIR/report.md; DIR/reproduction.md (written by
+`kushner reproduce`) goes into the report when present. Figures are written through a temporary name and
+renamed, like every kushner output.
 
   estimates.{png,svg}  one member: truth, each filter's estimate, the particle mean and its 5-95% band (one
                        panel per state component, up to 3); the filters' +-2 sigma bands are in trajectories.csv
@@ -43,6 +44,12 @@ def save(fig, directory, name):
     plt.close(fig)
 
 
+def reference_name(summary):
+    """What rmse_ref measures against, for labels: the particle filter unless the run says otherwise."""
+    ref = summary.get("reference") or {}
+    return "particle-filter" if ref.get("kind", "particle filter") == "particle filter" else ref.get("name", "reference")
+
+
 def color_of(names):
     return {n: COLORS[i % len(COLORS)] for i, n in enumerate(names)}
 
@@ -73,7 +80,8 @@ def plot_estimates(directory, summary, rows, colors):
                     ls=":", label="truth")
         ax.set_ylabel(f"x{c}")
         ax.grid(alpha=0.3)
-    axes[0, 0].set_title(f"{model_name(summary)}: member {member}, estimates and the particle filter's 5-95% band")
+    band = " and the particle filter's 5-95% band" if any(r["series"] == "PF" for r in rows) else ""
+    axes[0, 0].set_title(f"{model_name(summary)}: member {member}, estimates{band}")
     axes[-1, 0].set_xlabel("t")
     axes[0, 0].legend(fontsize=7, ncol=4, loc="upper right")
     save(fig, directory, "estimates")
@@ -93,7 +101,7 @@ def plot_errors(directory, summary, rows, colors):
     ax.set_yscale("log")
     ax.set_xlabel("t")
     ax.set_ylabel("RMS error over members")
-    ax.set_title("error to the truth (solid) and to the particle-filter mean (dashed)")
+    ax.set_title(f"error to the truth (solid) and to the {reference_name(summary)} mean (dashed)")
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=8, ncol=4)
     save(fig, directory, "errors")
@@ -106,9 +114,9 @@ def plot_rmse_ref(directory, summary, colors):
     filters.sort(key=lambda nf: nf[1]["rmse_ref"])
     fig, ax = plt.subplots(figsize=(max(5, 0.9 * len(filters) + 2), 4))
     names = [n for n, _ in filters]
-    ax.bar(names, [f["rmse_ref"] for _, f in filters], yerr=[2 * f.get("rmse_ref_se", 0.0) for _, f in filters],
+    ax.bar(names, [f["rmse_ref"] for _, f in filters], yerr=[2 * (f.get("rmse_ref_se") or 0.0) for _, f in filters],
            color=[colors.get(n) for n in names], capsize=4)
-    ax.set_ylabel("RMS distance to particle mean")
+    ax.set_ylabel(f"RMS distance to {reference_name(summary)} mean")
     ax.set_title("approximation error against the true conditional mean (+-2 SE)")
     ax.grid(alpha=0.3, axis="y")
     save(fig, directory, "rmse_ref")
@@ -158,13 +166,19 @@ def model_name(summary):
 def write_report(directory, summary, figures):
     backend = summary.get("backend", {})
     where = backend.get("device") or f"{backend.get('threads', '?')} threads"
-    lines = [f"# kushner compare: {model_name(summary)}", "",
+    reproduce = summary.get("reproduce")
+    title = f"kushner reproduce: {reproduce['example']}" if reproduce else f"kushner compare: {model_name(summary)}"
+    lines = [f"# {title}", "",
              f"- command: `{summary['command']}`",
              f"- seed {summary['seed']}, kushner {summary['version']} (git {summary.get('git', '?')}), "
              f"backend {backend.get('name', '?')} ({where}), Kokkos {backend.get('kokkos', '?')}",
              f"- members {summary['members']}, T = {summary['T']}, dt = {summary['dt']}"]
     if "file" in summary["model"]:
         lines.append(f"- model file: `{summary['model']['file']}` (coefficients in summary.json)")
+    truth = summary.get("truth")
+    if truth:
+        lines.append(f"- truths: `{truth['name']}` model, observation noise {truth['observation_noise']}; filters: "
+                     f"`{summary['model']['name']}` model")
     ref = summary.get("reference")
     if ref:
         if ref.get("kind") == "particle filter":
@@ -174,8 +188,13 @@ def write_report(directory, summary, figures):
                          f"error (noise floor of rmse_ref) {fmt(ref.get('noise_floor'))}")
         else:
             lines.append(f"- reference: {ref.get('kind')} ({ref.get('note', '')})")
+    reproduction = os.path.join(directory, "reproduction.md")
+    if os.path.exists(reproduction):
+        with open(reproduction) as f:
+            lines += ["", f.read().rstrip("\n")]
+    reference = "the particle-filter" if not ref or ref.get("kind") == "particle filter" else "the reference's"
     lines += ["", "## Metrics", "",
-              "`rmse_ref`: RMS distance to the particle-filter posterior mean (the approximation error against the "
+              f"`rmse_ref`: RMS distance to {reference} posterior mean (the approximation error against the "
               "true conditional density); `rmse_truth`: RMS error to the simulated truth; `nees`: mean normalized "
               "estimation error squared (the state dimension when the filter's covariance is honest); `diverged`: "
               "members whose covariance lost positive definiteness or whose values became non-finite. "
@@ -188,9 +207,12 @@ def write_report(directory, summary, figures):
                      f"{fmt(f.get('rmse_truth'), f.get('rmse_truth_se'))} | {fmt(f.get('nees'), f.get('nees_se'))} | "
                      f"{f.get('diverged', 0)} |")
     lines += ["", "## Figures", ""]
-    captions = {"estimates": "One member: truth, each filter's estimate, particle mean with its 5–95% band "
-                             "(the filters' ±2σ bands are in trajectories.csv).",
-                "errors": "RMS error over members against time: to the truth (solid), to the particle mean (dashed).",
+    particle = reference == "the particle-filter"
+    captions = {"estimates": "One member: truth, each filter's estimate" +
+                             (", particle mean with its 5–95% band" if particle else "") +
+                             " (the filters' ±2σ bands are in trajectories.csv).",
+                "errors": "RMS error over members against time: to the truth (solid), to the " +
+                          ("particle" if particle else "reference's") + " mean (dashed).",
                 "rmse_ref": "Approximation error per filter, with ±2 standard-error bars.",
                 "density": "Particle density (histogram) against each filter's Gaussian, one member."}
     for name in figures:

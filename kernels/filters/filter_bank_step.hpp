@@ -14,10 +14,14 @@ namespace kushner {
 template <class MemSpace, class... Filters>
 struct FilterSlots : FilterSlot<Filters, MemSpace>... {};
 
-template <class Model, class MemSpace, class... Filters>
+/// `TruthModel`: the truths' model, Model or one of the same dimensions (e.g. the system a Taylor model of it
+/// approximates, or Model with a deterministic observation noise); `model`: the filters' model.
+template <class Model, class TruthModel, class MemSpace, class... Filters>
 struct FilterBankStep {
-  EulerMaruyamaTruthStep<Model, MemSpace> truth;  // the truths' model; the filters' may differ in parameters
-  Model model;                                    // the filters' model
+  static_assert(TruthModel::state_dim == Model::state_dim && TruthModel::obs_dim == Model::obs_dim,
+                "FilterBankStep: the truths' model and the filters' model must have the same dimensions");
+  EulerMaruyamaTruthStep<TruthModel, MemSpace> truth;
+  Model model;
   BankScalar<Status, MemSpace> truth_status;      // non_finite once a truth escaped: not filtered, not scored
   FilterSlots<MemSpace, Filters...> slots;
   bool record;  // the step ends at an output time: fill the snapshots

@@ -1,0 +1,54 @@
+#pragma once
+// The examples of `kushner reproduce`, one function each (each compiled in its own translation unit: their
+// banks are separate template instantiations). Each runs the paper's experiment with the engine, writes the
+// compare artefacts into the output directory (or one subdirectory per run when the paper has several) and
+// fills the reproduction table from them; drivers/reproduce/reproduce_command.cpp writes the table, the
+// report and prints it.
+#include "drivers/output_directory.hpp"
+#include "drivers/reproduce/reproduction_table.hpp"
+#include "drivers/run_metadata.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+#include <vector>
+
+namespace kushner {
+
+/// The sizes of a run after the command line's overrides of the example's defaults.
+struct ReproduceSettings {
+  double T = 0.0;
+  long members = 0;
+  long long seed = 1;
+  int particles = 0;
+  double dt = 0.0;
+  bool quiet = false;
+  bool plots = true;
+};
+
+struct ExampleResult {
+  ReproductionTable table;
+  std::string notes;              // markdown: what ran, with which sizes and readings
+  nlohmann::json summary;         // one run: its compare summary; several: {"runs": {name: summary}}
+  std::vector<std::string> runs;  // subdirectories holding the runs' artefacts; empty: the output directory itself
+};
+
+/// The terminal values of `trajectories.csv` (as `kushner compare` writes it) for `member`: (series, component)
+/// -> estimate at the last time. KUSHNER_REQUIRE that the file exists and has that member.
+struct TerminalValues {
+  double t = 0.0;
+  double value(const std::string& series, int component) const;
+  std::vector<std::pair<std::string, std::vector<double>>> series;
+};
+TerminalValues terminal_values(const OutputDirectory& out, long member);
+
+ExampleResult reproduce_sunahara_ex1(const ReproduceSettings& settings, const RunContext& context,
+                                     const OutputDirectory& out);
+ExampleResult reproduce_sunahara_ex2(const ReproduceSettings& settings, const RunContext& context,
+                                     const OutputDirectory& out);
+ExampleResult reproduce_basin_car_filter(const ReproduceSettings& settings, const RunContext& context,
+                                         const OutputDirectory& out);
+ExampleResult reproduce_basin_terpolymer(const ReproduceSettings& settings, const RunContext& context,
+                                         const OutputDirectory& out);
+
+}  // namespace kushner

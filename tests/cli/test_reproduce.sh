@@ -1,0 +1,116 @@
+#!/usr/bin/env bash
+# `kushner reproduce`: basin-car-filter prints every paper value of both tables (both filters, both systems)
+# next to ours and writes the artefacts; its deterministic numbers are pinned (tests/data) and recomputed by a
+# second implementation (car_filter_reference.py); the other examples run at small sizes and fill their tables;
+# bad input is refused with one line, exit 2, nothing written.
+set -euo pipefail
+kushner=$1
+source "$(dirname "$0")/lib.sh"
+here=$(cd "$(dirname "$0")" && pwd)
+source_dir=$(cd "$here/../.." && pwd)
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+python=/usr/bin/python3
+[ -x "$python" ] || python=python3
+
+run_kushner "$work/car" reproduce basin-car-filter --out "$work/car" --quiet
+[ "$rc" -eq 0 ] || fail "reproduce basin-car-filter failed: $(cat "$work/car.err")"
+for f in summary.json reproduction.csv reproduction.md report.md; do
+  [ -s "$work/car/$f" ] || fail "reproduce basin-car-filter did not write $f"
+done
+for run in taylor tan; do
+  for f in summary.json timeseries.csv trajectories.csv report.md estimates.png estimates.svg errors.png errors.svg \
+           rmse_ref.png rmse_ref.svg; do
+    [ -s "$work/car/$run/$f" ] || fail "reproduce basin-car-filter did not write $run/$f"
+  done
+done
+find "$work/car" -name '*.tmp*' | grep -q . && fail "temporary files left behind"
+
+# stdout: every row of the data file, with the paper's value and ours, for both filters and both systems.
+"$python" - "$source_dir/drivers/reproduce/basin_car_filter.csv" "$work/car.out" "$work/car/reproduction.csv" <<'PY' \
+  || fail "reproduce basin-car-filter: table incomplete"
+import csv, math, re, sys
+data = list(csv.DictReader(l for l in open(sys.argv[1]) if not l.startswith("#")))
+out = open(sys.argv[2]).read().splitlines()
+rows = {r["key"]: r for r in csv.DictReader(l for l in open(sys.argv[3]) if not l.startswith("#"))}
+for system in ("taylor", "tan"):
+    for column in ("KB", "POLY3"):
+        for q in ("phi", "delta", "m_phi", "m_delta"):
+            assert any(d["key"] == f"{system}/{column}/{q}" and d["paper"] for d in data), (system, column, q)
+for d in data:
+    lines = [l for l in out if l.startswith(d["quantity"] + " ")]
+    assert len(lines) == 1, f"stdout has {len(lines)} lines for {d['quantity']!r}"
+    fields = lines[0][len(d["quantity"]):].split()
+    paper = d["paper"] or "-"
+    assert fields[0] == paper, f"{d['quantity']}: paper column {fields[0]!r}, data file {paper!r}"
+    ours = float(rows[d["key"]]["ours"])
+    assert math.isfinite(ours) and float(fields[1]) == float(f"{ours:.4g}"), (d["quantity"], fields, ours)
+    verdict = " ".join(fields[2:])
+    assert verdict == rows[d["key"]]["verdict"], (d["quantity"], verdict)
+    assert verdict == ("no number in paper" if not d["paper"] else verdict), verdict
+    assert verdict in ("reproduces", "does not reproduce", "no number in paper"), verdict
+assert "## Reproduction: basin-car-filter" in open(sys.argv[3].replace("reproduction.csv", "report.md")).read()
+PY
+echo "ok: reproduce basin-car-filter prints all $(grep -c '^[a-z]*/' "$source_dir/drivers/reproduce/basin_car_filter.csv") rows"
+
+# Regression: our deterministic numbers, pinned (tests/data/basin_car_filter_ours.csv, see its comment).
+"$python" - "$here/../data/basin_car_filter_ours.csv" "$work/car/reproduction.csv" <<'PY' || fail "car numbers moved"
+import csv, sys
+pinned = {r["key"]: r for r in csv.DictReader(l for l in open(sys.argv[1]) if not l.startswith("#"))}
+rows = {r["key"]: r for r in csv.DictReader(l for l in open(sys.argv[2]) if not l.startswith("#"))}
+assert set(pinned) == set(rows), set(pinned) ^ set(rows)
+for key, p in pinned.items():
+    ours, want = float(rows[key]["ours"]), float(p["ours"])
+    assert abs(ours - want) <= 1e-9 * max(1.0, abs(want)), f"{key}: {ours!r}, pinned {want!r}"
+    assert rows[key]["verdict"] == p["verdict"], f"{key}: verdict {rows[key]['verdict']!r}, pinned {p['verdict']!r}"
+print(f"ok: {len(pinned)} car numbers and verdicts as pinned")
+PY
+# A second implementation, at a coarser step to keep the test short (the same code paths as the default run).
+run_kushner "$work/car-coarse" reproduce basin-car-filter --dt 1e-3 --out "$work/car-coarse" --quiet --no-plots
+[ "$rc" -eq 0 ] || fail "reproduce basin-car-filter --dt 1e-3 failed: $(cat "$work/car-coarse.err")"
+"$python" "$here/car_filter_reference.py" "$work/car-coarse/reproduction.csv" 1e-3 \
+  || fail "car numbers differ from the Python reference"
+
+# The other examples, small: every row filled, artefacts written.
+small=(--members 6 --particles 64 --dt 0.01 --quiet --no-plots)
+for example in sunahara-ex1 sunahara-ex2; do
+  run_kushner "$work/$example" reproduce "$example" --out "$work/$example" "${small[@]}"
+  [ "$rc" -eq 0 ] || fail "reproduce $example failed: $(cat "$work/$example.err")"
+  for f in summary.json timeseries.csv trajectories.csv reproduction.csv reproduction.md; do
+    [ -s "$work/$example/$f" ] || fail "reproduce $example did not write $f"
+  done
+  grep -q "no number in paper" "$work/$example.out" || fail "reproduce $example: no table on stdout"
+done
+"$python" - "$work/sunahara-ex2/summary.json" <<'PY' || fail "sunahara-ex2: the printed start does not escape"
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert s["printed_x0"]["truths_escaped"] == s["printed_x0"]["members"] == 6, s["printed_x0"]
+assert s["reproduce"]["example"] == "sunahara-ex2" and len(s["reproduce"]["rows"]) == 8, s["reproduce"]
+PY
+run_kushner "$work/terp" reproduce basin-terpolymer --out "$work/terp" --dt 0.01 --quiet --no-plots
+[ "$rc" -eq 0 ] || fail "reproduce basin-terpolymer failed: $(cat "$work/terp.err")"
+grep -q "^claim: BILIN gives the best estimate of the three filters .*BILIN best" "$work/terp.out" \
+  || fail "basin-terpolymer: the claim row is missing: $(cat "$work/terp.out")"
+echo "ok: sunahara-ex1, sunahara-ex2, basin-terpolymer"
+
+expect_refused() {  # expect_refused "message fragment" args...: one line, exit 2, nothing written
+  local expected=$1; shift
+  run_kushner "$work/r" "$@"
+  [ "$rc" -eq 2 ] || fail "exit $rc (want 2) for: $*; stderr: $(cat "$work/r.err")"
+  [ "$(wc -l <"$work/r.err")" -eq 1 ] || fail "stderr is not one line for: $*: $(cat "$work/r.err")"
+  grep -qF -- "$expected" "$work/r.err" || fail "message lacks '$expected' for: $*: $(cat "$work/r.err")"
+  [ ! -s "$work/r.out" ] || fail "stdout not empty for: $*"
+  [ ! -e "$work/refused" ] || fail "a refused run created its output directory: $*"
+  echo "ok: $(cat "$work/r.err")"
+}
+expect_refused "reproduce: unknown example 'basin-car' (known: basin-car-filter, basin-terpolymer, sunahara-ex1, sunahara-ex2)" \
+  reproduce basin-car --out "$work/refused"
+expect_refused "--out is required" reproduce basin-car-filter
+expect_refused "--members: basin-car-filter is deterministic" reproduce basin-car-filter --members 10 --out "$work/refused"
+expect_refused "--seed: basin-terpolymer is deterministic" reproduce basin-terpolymer --seed 3 --out "$work/refused"
+expect_refused "--dt: the horizon of basin-car-filter, T = 20, must be a whole number of steps" reproduce basin-car-filter --dt 0.3 --out "$work/refused"
+expect_refused "--dt: must be positive (got -0.1)" reproduce sunahara-ex1 --dt -0.1 --out "$work/refused"
+expect_refused "--particles: must be at least 1 (got -4)" reproduce sunahara-ex1 --particles -4 --out "$work/refused"
+expect_refused "--members: must be in 1 .." reproduce sunahara-ex2 --members -1 --out "$work/refused"
+expect_refused "--members: must be in 1 .. 2147483647 (got 0)" reproduce sunahara-ex1 --members 0 --out "$work/refused"
+expect_refused "--seed: must be in 0 .. 4294967295 (got -1)" reproduce sunahara-ex1 --seed -1 --out "$work/refused"

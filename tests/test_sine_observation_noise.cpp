@@ -1,0 +1,86 @@
+// Basin's deterministic observation "noise" (models/sine_observation_noise.hpp) and truths that follow another
+// model than the filters (FilterBank's TruthModel): one step by hand, every member the same, every backend the
+// same bits, the Brownian path untouched, and a bank whose truths follow the tan car while its filters use the
+// Taylor model.
+#include "drivers/filter_bank.hpp"
+#include "drivers/simulate_ensemble.hpp"
+#include "models/car_model.hpp"
+#include "models/sine_model.hpp"
+#include "models/sine_observation_noise.hpp"
+#include "tests/test_spaces.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace kushner {
+namespace {
+
+template <class Space>
+class SineObservationNoiseTest : public ::testing::Test {};
+TYPED_TEST_SUITE(SineObservationNoiseTest, test::ExecutionSpaces);
+
+TYPED_TEST(SineObservationNoiseTest, IncrementIsTheIntegralOfSinOverTheStepForEveryMember) {
+  using Space = TypeParam;
+  CarTaylor3Model car;
+  car.x0_mean = Vec<2>{{0.3, 0.2}};
+  const SineObservationNoise<CarTaylor3Model> truth(car);
+  constexpr long members = 5;
+  TruthBank<Space, SineObservationNoise<CarTaylor3Model>> bank(Space(), truth, members, 7);
+  const double dt = 0.01;
+  bank.step(0, dt);  // [0, dt]
+  bank.step(1, dt);  // [dt, 2 dt]
+  Space().fence();
+  const auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bank.state());
+  const auto dy = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bank.observations());
+  // By hand: x1 = x0 + f(x0) dt; dy over [dt, 2 dt] = x1 dt + r (cos dt - cos 2dt), r = 1.
+  const double d0 = 0.2, phi1 = 0.3 + (d0 + d0 * d0 * d0 / 3.0) * dt, d1 = d0 + car.u * dt;
+  const double noise = std::cos(dt) - std::cos(2.0 * dt);
+  for (long m = 0; m < members; ++m) {
+    EXPECT_DOUBLE_EQ(dy(m, 0), phi1 * dt + noise) << "member " << m;
+    EXPECT_DOUBLE_EQ(dy(m, 1), d1 * dt + noise) << "member " << m;
+    EXPECT_EQ(x(m, 0), x(0, 0));
+    EXPECT_EQ(dy(m, 1), dy(0, 1));
+  }
+}
+
+TEST(SineObservationNoise, BrownianModelsKeepTheirRandomIncrements) {
+  using Space = Kokkos::DefaultExecutionSpace;
+  static_assert(!has_deterministic_observation_noise<SineModel>);
+  static_assert(has_deterministic_observation_noise<SineObservationNoise<SineModel>>);
+  SineModel model;
+  model.x0_cov = Mat<1, 1>::zero();
+  TruthBank<Space, SineModel> brownian(Space(), model, 2, 3);
+  TruthBank<Space, SineObservationNoise<SineModel>> sine(Space(), SineObservationNoise<SineModel>(model), 2, 3);
+  brownian.step(0, 0.01);
+  sine.step(0, 0.01);
+  Space().fence();
+  const auto a = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), brownian.observations());
+  const auto b = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sine.observations());
+  EXPECT_NE(a(0, 0), a(1, 0)) << "Brownian members share their noise";
+  EXPECT_EQ(b(0, 0), b(1, 0));
+  EXPECT_DOUBLE_EQ(b(0, 0), 1.0 * 0.01 + model.r * (1.0 - std::cos(0.01)));
+}
+
+/// The car of seed 002 L1505 (tan truth, Taylor-model filters): the truths follow tan, not the Taylor model.
+TEST(TruthModel, BankTruthsFollowTheirOwnModel) {
+  using Space = Kokkos::DefaultExecutionSpace;
+  CarTaylor3Model taylor;
+  taylor.x0_mean = Vec<2>{{0.0, 1.0}};  // delta = 1: tan 1 = 1.557 against the Taylor model's 1.333
+  CarModel tan;
+  static_cast<CarBase&>(tan) = taylor;
+  const double dt = 1e-3;
+  FilterBank<Space, CarTaylor3Model, CarModel> bank(Space(), tan, taylor, 3, 1, {"KBL", "POLY3"}, FilterConfig{});
+  bank.step(0, dt, true);
+  Space().fence();
+  const auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bank.truths().state());
+  EXPECT_DOUBLE_EQ(x(0, 0), std::tan(1.0) * dt);
+  FilterBank<Space, CarTaylor3Model> same(Space(), taylor, taylor, 3, 1, {"KBL", "POLY3"}, FilterConfig{});
+  same.step(0, dt, true);
+  Space().fence();
+  const auto y = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), same.truths().state());
+  EXPECT_DOUBLE_EQ(y(0, 0), (1.0 + 1.0 / 3.0) * dt);
+}
+
+}  // namespace
+}  // namespace kushner
