@@ -73,37 +73,40 @@ std::vector<std::string> select_filters(const std::string& list) {
 /// supports plus PF where it applies; EXACT only on request (the grid filter is far slower than the rest).
 template <class Model>
 std::vector<std::string> select_estimators(const std::string& list, const Model& model) {
+  KUSHNER_INPUT_REQUIRE(!list.empty(), "--filters: empty list");
   std::string bank_list;
-  bool particle = list == "all" && particle_filter_unsupported<Model>() == nullptr, exact = false;
-  if (list == "all") {
-    bank_list = "all";
-  } else {
-    std::string current;
-    for (std::size_t i = 0; i <= list.size(); ++i) {
-      if (i < list.size() && list[i] != ',') {
-        if (list[i] != ' ') current += list[i];
-        continue;
-      }
-      if (current == "PF") {
-        KUSHNER_INPUT_REQUIRE(particle_filter_unsupported<Model>() == nullptr,
-                              "filter PF does not support model '" << Model::name << "' ("
-                                                                   << particle_filter_unsupported<Model>() << ")");
-        particle = true;
-      } else if (current == "EXACT") {
-        KUSHNER_INPUT_REQUIRE(has_exact_reference<Model>, "filter EXACT does not support model '"
-                                                              << Model::name
-                                                              << "' (no exact filter, and no grid filter above "
-                                                                 "dimension 2 or for discrete time)");
-        const char* why_not = runtime_filter_unsupported(model, "EXACT");
-        KUSHNER_INPUT_REQUIRE(why_not == nullptr,
-                              "filter EXACT does not support model '" << Model::name << "' (" << why_not << ")");
-        exact = true;
-      } else {
-        bank_list += (bank_list.empty() ? "" : ",") + current;
-      }
-      current.clear();
+  bool all = false, particle = false, exact = false;
+  std::string current;
+  for (std::size_t i = 0; i <= list.size(); ++i) {
+    if (i < list.size() && list[i] != ',') {
+      if (list[i] != ' ') current += list[i];
+      continue;
     }
-    KUSHNER_INPUT_REQUIRE(!list.empty(), "--filters: empty list");
+    if (current == "all") {
+      all = true;
+    } else if (current == "PF") {
+      KUSHNER_INPUT_REQUIRE(particle_filter_unsupported<Model>() == nullptr,
+                            "filter PF does not support model '" << Model::name << "' ("
+                                                                 << particle_filter_unsupported<Model>() << ")");
+      particle = true;
+    } else if (current == "EXACT") {
+      KUSHNER_INPUT_REQUIRE(has_exact_reference<Model>, "filter EXACT does not support model '"
+                                                            << Model::name
+                                                            << "' (no exact filter, and no grid filter above "
+                                                               "dimension 2 or for discrete time)");
+      const char* why_not = runtime_filter_unsupported(model, "EXACT");
+      KUSHNER_INPUT_REQUIRE(why_not == nullptr,
+                            "filter EXACT does not support model '" << Model::name << "' (" << why_not << ")");
+      exact = true;
+    } else {
+      bank_list += (bank_list.empty() ? "" : ",") + current;
+    }
+    current.clear();
+  }
+  if (all) {  // "all" anywhere in the list (e.g. all,EXACT): every bank filter, and PF where it applies
+    if (!bank_list.empty()) select_filters<Model>(bank_list, model);  // names beside it must still be valid
+    bank_list = "all";
+    particle = particle || particle_filter_unsupported<Model>() == nullptr;
   }
   std::vector<std::string> names =
       bank_list.empty() ? std::vector<std::string>{} : select_filters<Model>(bank_list, model);

@@ -65,6 +65,16 @@ assert all(math.isfinite(float(r["rmse_truth"])) for r in rows)
 PY
 echo "ok: summary.json and timeseries.csv"
 
+# "all" beside named references: every supported bank filter, PF, and EXACT; a bad name beside it still refused.
+"$kushner" filter --model sine --filters all,EXACT --members 20 --particles 64 --T 0.1 --dt 1e-2 --out "$work/all" --quiet
+python3 -c '
+import json, sys
+order = json.load(open(sys.argv[1]))["filter_order"]
+assert order == ["EKF", "EKF-DS", "SOF", "SOF-B", "QLF", "ASRE", "KBL", "PF", "EXACT"], order
+' "$work/all/summary.json" || fail "--filters all,EXACT is not every bank filter plus PF and EXACT"
+expect_refused "filter KB does not support model 'sine' (model is not linear)" filter --model sine --filters all,KB
+echo "ok: --filters all,EXACT"
+
 # `kushner filters`: every filter and the models it supports, as text and JSON.
 "$kushner" filters >"$work/list.txt"
 grep -q '^POLY3 ' "$work/list.txt" || fail "no POLY3 in kushner filters"
