@@ -7,7 +7,9 @@
 #             T = 10, dt = 1e-3 (the tables of the filter-bank and compare issues)
 #   pf        perf/run_gpu_benchmarks.sh's phases (PF_PHASES, default "compare sizes"): the particle-filter
 #             step at M = 1000, N = 65536 beside PyTorch eager and torch.compile in the same call, then every size
-# Results: $OUT/results.tgz (every log, JSON and summary) and $OUT/steps.log.
+# Results: $OUT/results.tgz (every log, JSON and summary) and $OUT/steps.log. A phase that needs the build runs
+# the build first when build-cuda/ is missing (a fresh device machine). KUSHNER_DEADLINE (seconds, default 570):
+# no step runs past it, so the results are packed before the device call's limit.
 #   OUT=<dir> KUSHNER_PHASES="build test" perf/run_gpu_validation.sh
 set -uo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
@@ -19,10 +21,12 @@ phases=" ${KUSHNER_PHASES:-build test bench compare} "
 want() { [[ "$phases" == *" $1 "* ]]; }
 export PATH=/usr/local/cuda/bin:$PATH CMAKE_POLICY_VERSION_MINIMUM=3.5 OMP_PROC_BIND=false
 status=0
+deadline=${KUSHNER_DEADLINE:-570}
 step() {  # step NAME CMD...: output to NAME.log, time and exit code to steps.log
   local name=$1; shift
-  local t0=$SECONDS
-  "$@" > "$work/$name.log" 2>&1
+  local t0=$SECONDS left=$((deadline - SECONDS))
+  [ $left -gt 5 ] || { echo "$name: skipped (deadline)" | tee -a "$work/steps.log"; status=1; return 1; }
+  timeout $left "$@" > "$work/$name.log" 2>&1
   local rc=$?
   echo "$name: exit $rc, $((SECONDS - t0)) s" | tee -a "$work/steps.log"
   [ $rc -eq 0 ] || status=1
@@ -30,17 +34,19 @@ step() {  # step NAME CMD...: output to NAME.log, time and exit code to steps.lo
 }
 pack() { cp "$work/steps.log" "$out/" 2>/dev/null; tar -czf "$out/results.tgz" -C "$work" .; }
 trap pack EXIT
+trap 'exit 1' TERM INT
 nvidia-smi --query-gpu=name,memory.total,clocks.max.sm,driver_version --format=csv,noheader > "$work/gpu.txt" 2>&1
 git -C "$here" describe --always --dirty --abbrev=12 > "$work/git.txt" 2>&1
 cat "$work/gpu.txt"
 
+if ! want build && [ ! -x "$build/kushner" ]; then phases="$phases build "; fi
 if want build; then
   step configure cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON \
     -DKUSHNER_ENABLE_OPENMP=ON -DKUSHNER_ENABLE_THRUST=ON || { cat "$work/configure.log"; exit 1; }
   step build cmake --build "$build" -j16 || { grep -B2 -A12 -m3 "error" "$work/build.log"; exit 1; }
 fi
 if want test; then
-  (cd "$build" && step ctest ctest -j4 --output-on-failure --timeout 400)
+  step ctest ctest --test-dir "$build" -j4 --output-on-failure --timeout 400
   grep -E "tests passed|Failed|\*\*\*|Total Test" "$work/ctest.log"
 fi
 if want bench; then
@@ -60,7 +66,7 @@ if want compare; then
 fi
 if want pf; then
   OUT="$work/pf" KUSHNER_PHASES="${PF_PHASES:-compare sizes}" KUSHNER_REPETITIONS="${KUSHNER_REPETITIONS:-10}" \
-    bash "$here/perf/run_gpu_benchmarks.sh" > "$work/pf.log" 2>&1 || status=1
+    step pf bash "$here/perf/run_gpu_benchmarks.sh"
   cat "$work/pf/summary.txt" 2>/dev/null
 fi
 exit $status
