@@ -9,6 +9,7 @@
 #include "drivers/reference_estimator.hpp"
 #include "drivers/run_metadata.hpp"
 #include "kernels/errors.hpp"
+#include "kernels/host_copy.hpp"
 #include "kernels/particle_filter/particle_snapshot.hpp"
 
 #include <Kokkos_Core.hpp>
@@ -86,7 +87,7 @@ class TrajectoryRecorder {
  private:
   template <class View>
   static auto row(const View& v, long member) {
-    return Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), Kokkos::subview(v, member, Kokkos::ALL));
+    return host_copy(Kokkos::subview(v, member, Kokkos::ALL));
   }
 
   void add_trajectory(long member, double t, int i, const std::string& series, double estimate, double lower,

@@ -60,7 +60,7 @@ if want test; then
 fi
 
 if want compare; then
-  run bench_compare "$build/perf/bench_particle_filter" --benchmark_filter='members:1000/particles:65536/(per_thread:0/resample:1/)?manual' \
+  run bench_compare "$build/perf/bench_particle_filter" --benchmark_filter='members:1000/particles:65536/' \
     --benchmark_repetitions="$reps" --benchmark_enable_random_interleaving=true \
     --benchmark_out="$out/bench_compare.json" --benchmark_out_format=json
   run torch_eager python3 "$here/perf/pf_torch.py" --mode eager --members 1000 --particles 65536 --repetitions "$reps"

@@ -46,7 +46,8 @@ if want build; then
   step build cmake --build "$build" -j16 || { grep -B2 -A12 -m3 "error" "$work/build.log"; exit 1; }
 fi
 if want test; then
-  step ctest ctest --test-dir "$build" -j4 --output-on-failure --timeout 400
+  # 8 tests at a time on 16 cores: each host (OpenMP) part gets 2 threads unless the test sets its own count
+  OMP_NUM_THREADS=2 step ctest ctest --test-dir "$build" -j8 --output-on-failure --timeout 400
   grep -E "tests passed|Failed|\*\*\*|Total Test" "$work/ctest.log"
 fi
 if want bench; then

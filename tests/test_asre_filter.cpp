@@ -44,8 +44,8 @@ TEST(AsreFilter, IterateIEqualsTheCausalSdcFilterOnTheFirstIPlusOneSteps) {
         difference = std::max(difference, std::abs(asre(i, 0) - m[i]) / std::abs(m[i]));
       }
     });
-    if (k + 1 <= iterations + 1) {
-      EXPECT_LT(difference, 1e-14) << "step " << k;
+    if (k + 1 <= iterations + 1) {  // a few ulps: a GPU contracts the bank's products into FMAs, the host does not
+      EXPECT_LT(difference, 1e-13) << "step " << k;
     }
     if (k + 1 == 30) {
       EXPECT_GT(difference, 1e-9) << "iterate " << iterations << " still equal to the SDC filter";

@@ -61,6 +61,21 @@ TEST(ParticleSnapshot, PosteriorMedianMatchesKalmanMean) {
   }
 }
 
+// A snapshot of a few members copies strided slices of the bank (one member's particles, every component);
+// it must hold the same numbers as the whole-bank copy -- on a GPU that copy cannot go straight to the host.
+TEST(ParticleSnapshot, ChosenMembersHoldTheSameParticlesAsTheWholeBank) {
+  LinearModel<2> model;
+  ParticleFilterBank<Space, LinearModel<2>> pf(Space(), model, 5, 256, 7);
+  const ParticleSnapshot whole(pf), chosen(pf, {3, 1});
+  for (int m : {1, 3})
+    for (int i = 0; i < 2; ++i) {
+      EXPECT_EQ(chosen.quantiles(m, i, {0.1, 0.5, 0.9}), whole.quantiles(m, i, {0.1, 0.5, 0.9})) << m << " " << i;
+      EXPECT_EQ(chosen.histogram(m, i, -2.0, 4.0, 12), whole.histogram(m, i, -2.0, 4.0, 12)) << m << " " << i;
+    }
+  EXPECT_NE(whole.quantiles(1, 0, {0.5}), whole.quantiles(3, 0, {0.5}));  // distinct members, distinct draws
+  EXPECT_THROW(chosen.quantiles(0, 0, {0.5}), std::logic_error);  // member 0 was not copied
+}
+
 static_assert(std::is_same_v<exact_reference_t<Space, LinearModel<2>>, KalmanBucyReference<Space, 2>>);
 static_assert(std::is_same_v<exact_reference_t<Space, BenesModel>, BenesFilter<Space>>);
 static_assert(std::is_same_v<exact_reference_t<Space, SineModel>, GridFilter<Space, SineModel>>);

@@ -4,6 +4,7 @@
 // a few chosen ones); every statistic below is then computed there, in particle order, so it is
 // deterministic. Host code only.
 #include "kernels/errors.hpp"
+#include "kernels/host_copy.hpp"
 #include "kernels/particle_filter/particle_filter_bank.hpp"
 
 #include <Kokkos_Core.hpp>
@@ -45,8 +46,7 @@ class ParticleSnapshot {
       column_[m] = static_cast<int>(k);
       const auto lw = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(),
                                                           Kokkos::subview(pf.log_weights(), Kokkos::ALL, m));
-      const auto x = Kokkos::create_mirror_view_and_copy(
-          Kokkos::HostSpace(), Kokkos::subview(pf.particles(), Kokkos::ALL, m, Kokkos::ALL));
+      const auto x = host_copy(Kokkos::subview(pf.particles(), Kokkos::ALL, m, Kokkos::ALL));
       for (int j = 0; j < particles_; ++j) {
         w_(j, k) = std::exp(lw(j) - ln(m));
         for (int i = 0; i < dim_; ++i) x_(j, k, i) = x(j, i);
