@@ -3,6 +3,7 @@
 #include "drivers/commands.hpp"
 #include "models/registry.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -29,8 +30,10 @@ void print_summary(const nlohmann::json& summary, const std::string& out) {
   }
   if (summary.contains("plots_error")) std::fprintf(stderr, "kushner: warning: %s\n",
                                                     summary["plots_error"].get<std::string>().c_str());
+  const bool report = std::any_of(summary["files"].begin(), summary["files"].end(),
+                                  [](const nlohmann::json& f) { return f == "report.md"; });
   std::printf("written to %s/ (%s)\n", out.c_str(),
-              summary.value("plots", false) ? "report.md, plots, CSV, JSON" : "CSV, JSON");
+              summary.value("plots", false) ? "report.md, plots, CSV, JSON" : report ? "report.md, CSV, JSON" : "CSV, JSON");
 }
 
 int run_estimation(const CompareOptions& options, const RunContext& context, const char* command) {

@@ -103,10 +103,8 @@ std::vector<std::string> check_compare_options(const Model& model, const Compare
 inline void add_plots(const OutputDirectory& out, nlohmann::json& summary) {
   const PlotResult plots = write_plots_and_report(out);
   summary["plots"] = plots.ok;
-  if (plots.ok)
-    for (const auto& file : plots.files) summary["files"].push_back(file);
-  else
-    summary["plots_error"] = plots.message;
+  for (const auto& file : plots.files) summary["files"].push_back(file);  // report.md even without figures
+  if (!plots.ok) summary["plots_error"] = plots.message;
   out.write("summary.json", summary.dump(2) + "\n");
 }
 

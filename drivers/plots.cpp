@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <string>
 
+#include <sys/wait.h>
+
 #ifndef KUSHNER_SOURCE_DIR
 #error "KUSHNER_SOURCE_DIR must name the source tree (it holds drivers/plots/compare_plots.py)"
 #endif
@@ -42,10 +44,14 @@ PlotResult write_plots_and_report(const OutputDirectory& out) {
   std::array<char, 512> buffer;
   while (std::fgets(buffer.data(), buffer.size(), pipe)) output += buffer.data();
   const int status = pclose(pipe);
+  constexpr int report_without_figures = 3;  // compare_plots.py's exit status when matplotlib is missing
+  const bool report_only = WIFEXITED(status) && WEXITSTATUS(status) == report_without_figures;
   if (status != 0) {
     while (!output.empty() && output.back() == '\n') output.pop_back();
     const auto last = output.rfind('\n');
-    result.message = "plotting failed: " + (last == std::string::npos ? output : output.substr(last + 1));
+    const std::string reason = last == std::string::npos ? output : output.substr(last + 1);
+    result.message = (report_only ? "no figures: " : "plotting failed: ") + reason;
+    if (report_only) result.files.push_back("report.md");
     return result;
   }
   result.ok = true;

@@ -1,15 +1,19 @@
 // Prints the particle filter's per-member outputs (posterior mean, covariance, ESS, resampling count) as
 // exact hexadecimal floats, for the reproducibility test (cli/test_particle_filter_reproducibility.sh) to
 // compare byte for byte across thread counts and backends. The backend comes from KUSHNER_BACKEND, the
-// threads from OMP_NUM_THREADS, as for the kushner command.
+// threads from OMP_NUM_THREADS, as for the kushner command. `particle_filter_dump car` prints Basin's car
+// instead (no process noise: tan drift, deterministic particles between resamplings), for looking at how a
+// GPU run departs from a host one.
 #include "drivers/backend.hpp"
 #include "drivers/simulate_ensemble.hpp"
 #include "kernels/particle_filter/particle_filter_bank.hpp"
+#include "models/car_model.hpp"
 #include "models/cubic_oscillator_model.hpp"
 #include "models/linear_model.hpp"
 #include "models/sine_model.hpp"
 
 #include <cstdio>
+#include <string>
 
 namespace kushner {
 namespace {
@@ -39,10 +43,15 @@ void dump(const char* label, Model model, int members, int particles, int steps,
 }  // namespace
 }  // namespace kushner
 
-int main() {
+int main(int argc, char** argv) {
   kushner::KokkosSession session;
-  kushner::with_backend(kushner::selected_backend(), [](const auto& space) {
+  const bool car = argc > 1 && std::string(argv[1]) == "car";
+  kushner::with_backend(kushner::selected_backend(), [car](const auto& space) {
     using Space = std::decay_t<decltype(space)>;
+    if (car) {
+      kushner::dump<Space>("car", kushner::CarModel{}, 500, 1024, 100, 5e-3, kushner::ResamplingScheme::systematic);
+      return;
+    }
     kushner::dump<Space>("sine", kushner::SineModel{}, 24, 3000, 300, 1e-2, kushner::ResamplingScheme::systematic);
     kushner::dump<Space>("linear2", kushner::LinearModel<2>{}, 10, 1500, 200, 1e-2, kushner::ResamplingScheme::stratified);
     kushner::CubicOscillatorModel cubic;

@@ -5,7 +5,8 @@ usage: compare_plots.py DIR
 
 Reads DIR/summary.json, DIR/timeseries.csv, DIR/trajectories.csv and (1-D models) DIR/density.csv, as written
 by `kushner compare`, and writes PNG and SVG figures plus DIR/report.md; DIR/reproduction.md (written by
-`kushner reproduce`) goes into the report when present. Figures are written through a temporary name and
+`kushner reproduce`) goes into the report when present. Without matplotlib only report.md is written (its
+tables, and a line saying why there are no figures) and the exit status is 3. Figures are written through a temporary name and
 renamed, like every kushner output.
 
   estimates.{png,svg}  one member: truth, each filter's estimate, the particle mean and its 5-95% band (one
@@ -21,10 +22,9 @@ import os
 import sys
 from collections import defaultdict
 
-import matplotlib
+plt = None  # matplotlib.pyplot, imported by main(): without matplotlib report.md is still written
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+NO_FIGURES = 3  # exit status: report.md written, figures not drawn (the last line of output says why)
 
 COLORS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f",
           "#bcbd22", "#17becf", "#393b79", "#637939"]
@@ -163,7 +163,7 @@ def model_name(summary):
     return model["name"]
 
 
-def write_report(directory, summary, figures):
+def write_report(directory, summary, figures, no_figures=None):
     backend = summary.get("backend", {})
     where = backend.get("device") or f"{backend.get('threads', '?')} threads"
     reproduce = summary.get("reproduce")
@@ -207,6 +207,8 @@ def write_report(directory, summary, figures):
                      f"{fmt(f.get('rmse_truth'), f.get('rmse_truth_se'))} | {fmt(f.get('nees'), f.get('nees_se'))} | "
                      f"{f.get('diverged', 0)} |")
     lines += ["", "## Figures", ""]
+    if no_figures:
+        lines += [f"Not drawn: {no_figures}.", ""]
     particle = reference == "the particle-filter"
     captions = {"estimates": "One member: truth, each filter's estimate" +
                              (", particle mean with its 5–95% band" if particle else "") +
@@ -228,6 +230,16 @@ def main():
         sys.exit(__doc__)
     directory = sys.argv[1]
     summary = json.load(open(os.path.join(directory, "summary.json")))
+    global plt
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        why = "matplotlib is not installed for " + sys.executable + " (Debian: python3-matplotlib)"
+        write_report(directory, summary, [], why)
+        print(why)
+        sys.exit(NO_FIGURES)
     colors = color_of([n for n in summary["filters"] if n != "PF"])
     figures = []
     trajectories = os.path.join(directory, "trajectories.csv")
