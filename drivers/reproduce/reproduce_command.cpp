@@ -9,6 +9,7 @@
 #include "kernels/errors.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -161,6 +162,11 @@ std::string multi_run_report(const std::string& example, const nlohmann::json& s
       if (std::find(summary["runs"][run]["files"].begin(), summary["runs"][run]["files"].end(),
                     std::string(figure) + ".png") != summary["runs"][run]["files"].end())
         report += "![" + run + " " + figure + "](" + run + "/" + figure + ".png)\n\n";
+    if (summary["runs"][run].contains("plots_error")) {  // "no figures: ..." or "plotting failed: ..."
+      std::string why = summary["runs"][run]["plots_error"].get<std::string>();
+      why[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(why[0])));
+      report += why + ".\n\n";
+    }
   }
   return report;
 }
@@ -200,9 +206,7 @@ int run_reproduce(const ReproduceOptions& options, const RunContext& context_in)
     top["reproduce"] = {{"example", example.name}, {"rows", rows_json(result.table)}};
     top["runs"] = summary["runs"];
     top["files"] = {"summary.json", "reproduction.csv", "reproduction.md"};
-    bool plots_ok = settings.plots;
-    for (const auto& run : result.runs) plots_ok = plots_ok && summary["runs"][run].value("plots", false);
-    if (plots_ok) {
+    if (settings.plots) {  // with each run's figures where they were drawn (not without matplotlib)
       out.write("report.md", multi_run_report(example.name, top, table_md, result.runs));
       top["files"].push_back("report.md");
     }
@@ -216,8 +220,10 @@ int run_reproduce(const ReproduceOptions& options, const RunContext& context_in)
     if (summary["runs"][run].contains("plots_error"))
       std::fprintf(stderr, "kushner: warning: %s: %s\n", run.c_str(),
                    summary["runs"][run]["plots_error"].get<std::string>().c_str());
+  bool figures = settings.plots && summary.value("plots", true);
+  for (const auto& run : result.runs) figures = figures && summary["runs"][run].value("plots", false);
   std::printf("written to %s/ (reproduction.csv, reproduction.md%s)\n", options.out.c_str(),
-              settings.plots ? ", report.md, plots, CSV, JSON" : ", CSV, JSON");
+              figures ? ", report.md, plots, CSV, JSON" : settings.plots ? ", report.md, CSV, JSON" : ", CSV, JSON");
   return 0;
 }
 
