@@ -2,11 +2,19 @@
 // Member kernels: one functor call per ensemble member, the same bits on every host backend.
 //
 // GCC vectorizes the loop of Kokkos' Serial backend around an inlined functor but not the OpenMP backend's,
-// and a vectorized loop calls glibc's vector sin/cos/exp/log (kernels/particle_filter/vector_math.hpp), which
+// and a vectorized loop calls glibc's vector sin/cos/exp/log (kernels/vector_math.hpp), which
 // differ from the scalar ones in the last bits: the same kernel gave Serial and OpenMP results one ulp apart
 // (Box-Muller of the initial states, -march=native). So on the host the members go in fixed chunks through
 // one function per functor type that is never inlined or cloned: every backend and every thread count runs
 // the same machine code on the same chunks. On a GPU it is a RangePolicy over the members.
+//
+// The vector-math declarations are included here, not only where the particle filter needs them: a chunk
+// function is instantiated in every translation unit that runs the functor and the linker keeps one copy, so
+// every unit must compile it alike. Without them in one unit its copy was scalar (bench_simulate_truth's truth
+// step ran 5.4 times slower than the same step in bench_filter_bank), and which copy a program ran, and so its
+// last bits, depended on link order.
+#include "kernels/vector_math.hpp"
+
 #include <Kokkos_Core.hpp>
 
 #include <string>

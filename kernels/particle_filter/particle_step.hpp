@@ -14,7 +14,7 @@
 #include "kernels/math.hpp"
 #include "kernels/particle_filter/particle_draws.hpp"
 #include "kernels/particle_filter/particle_model_traits.hpp"
-#include "kernels/particle_filter/vector_math.hpp"
+#include "kernels/vector_math.hpp"
 #include "kernels/particle_filter/weighted_moments.hpp"
 #include "kernels/rng.hpp"
 #include "kernels/status.hpp"

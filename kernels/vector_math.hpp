@@ -6,7 +6,8 @@
 // Measured here (AMD EPYC, -march=native): the particle-filter block loop runs 2.1e7 particle-steps/s per
 // core with scalar libm and 1.4e8 with libmvec. libmvec's results are within 4 ulp of libm's, so the CPU
 // numbers differ from a scalar build in the last bits; within one binary they are the same on any number
-// of threads, because every backend calls the same block function (particle_block_kernel.hpp).
+// of threads, because every backend calls the same block function (particle_block_kernel.hpp) or member
+// chunk function (for_each_member.hpp, which includes this header so that every unit compiles it alike).
 #if defined(KUSHNER_VECTOR_MATH) && defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && \
     !defined(__CUDACC__)
 #include <cmath>
