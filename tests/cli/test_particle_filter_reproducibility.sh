@@ -26,7 +26,7 @@ import sys
 for host, device in ((sys.argv[1], sys.argv[2]), (sys.argv[3], sys.argv[4])):
     a, b = ([l.split() for l in open(p)] for p in (host, device))
     assert len(a) == len(b) and len(a) > 0, (host, len(a), len(b))
-    worst = (0.0, None)
+    worst = (0.0, "")
     for x, y in zip(a, b):
         assert x[:2] == y[:2] and x[-1] == y[-1], f"member {x[:2]}: resampling count {x[-1]} on the host, {y[-1]} on cuda"
         for p, q in zip(map(float.fromhex, x[2:-1]), map(float.fromhex, y[2:-1])):
