@@ -20,16 +20,8 @@ namespace {
 template <class TruthModel>
 nlohmann::json run_table(const TruthModel& truth, const CarTaylor3Model& model, const ReproduceSettings& settings,
                          const RunContext& context, const OutputDirectory& out) {
-  CompareOptions options;
-  options.run.model = model.name;
-  options.run.members = 1;
-  options.run.T = settings.T;
-  options.run.dt = settings.dt;
-  options.run.seed = settings.seed;
-  options.run.quiet = settings.quiet;
-  options.filters = "KBL,POLY3";
-  options.trajectory_members = {0};
-  options.plots = settings.plots;
+  CompareOptions options = example_options(model.name, "KBL,POLY3", 1, settings);
+  options.plots = settings.plots;  // each table's run draws its own figures
   const TimeGrid grid = make_time_grid(options.run.T, options.run.dt, options.run.output_points);
   const auto make_extras = [&](const auto& space) {
     using ExecSpace = std::decay_t<decltype(space)>;

@@ -4,6 +4,7 @@
 // compare artefacts into the output directory (or one subdirectory per run when the paper has several) and
 // fills the reproduction table from them; drivers/reproduce/reproduce_command.cpp writes the table, the
 // report and prints it.
+#include "drivers/filter_options.hpp"
 #include "drivers/output_directory.hpp"
 #include "drivers/reproduce/reproduction_table.hpp"
 #include "drivers/run_metadata.hpp"
@@ -25,6 +26,25 @@ struct ReproduceSettings {
   bool quiet = false;
   bool plots = true;
 };
+
+/// The compare options an example starts from: the settings' sizes and seed, `filters` run on `members`
+/// members, the first (up to) three members' trajectories recorded, and no plots (the command draws them once
+/// the reproduction table is written).
+inline CompareOptions example_options(const char* model, const char* filters, long members,
+                                      const ReproduceSettings& settings) {
+  CompareOptions options;
+  options.run.model = model;
+  options.run.members = members;
+  options.run.T = settings.T;
+  options.run.dt = settings.dt;
+  options.run.seed = settings.seed;
+  options.run.quiet = settings.quiet;
+  options.filters = filters;
+  options.trajectory_members.clear();
+  for (long m = 0; m < 3 && m < members; ++m) options.trajectory_members.push_back(m);
+  options.plots = false;
+  return options;
+}
 
 struct ExampleResult {
   ReproductionTable table;

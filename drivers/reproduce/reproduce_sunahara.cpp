@@ -17,19 +17,20 @@ namespace {
 constexpr const char* table_filters = "QLF,SOF,SOF-B,EKF,EKF-DS,PF";
 
 CompareOptions stochastic_options(const char* model, const ReproduceSettings& settings) {
-  CompareOptions options;
-  options.run.model = model;
-  options.run.members = settings.members;
-  options.run.T = settings.T;
-  options.filters = table_filters;
-  options.run.dt = settings.dt;
-  options.run.seed = settings.seed;
-  options.run.quiet = settings.quiet;
+  CompareOptions options = example_options(model, table_filters, settings.members, settings);
   options.particles = settings.particles;
-  options.trajectory_members.clear();
-  for (long m = 0; m < 3 && m < settings.members; ++m) options.trajectory_members.push_back(m);
-  options.plots = false;  // drawn by the command once the reproduction table is written
   return options;
+}
+
+/// The paper's table filters and the particle reference on `model`, as one compare run into `out`.
+template <class Model>
+ExampleResult run_table_example(const char* example, const Model& model, const ReproduceSettings& settings,
+                                const RunContext& context, const OutputDirectory& out) {
+  const CompareOptions options = stochastic_options(model.name, settings);
+  const TimeGrid grid = make_time_grid(options.run.T, options.run.dt, options.run.output_points);
+  ExampleResult result{ReproductionTable(example), "", {}, {}};
+  result.summary = run_compare_command(model, options, filter_config(options), grid, context, out);
+  return result;
 }
 
 double number(const nlohmann::json& filter, const char* key) {
@@ -65,10 +66,7 @@ std::string sizes(const ReproduceSettings& settings) {
 ExampleResult reproduce_sunahara_ex1(const ReproduceSettings& settings, const RunContext& context,
                                      const OutputDirectory& out) {
   const SineModel model;  // q = 1, r = 0.5, x(0) ~ N(1, 1) for the truths and the filters' prior
-  const CompareOptions options = stochastic_options(model.name, settings);
-  const TimeGrid grid = make_time_grid(options.run.T, options.run.dt, options.run.output_points);
-  ExampleResult result{ReproductionTable("sunahara-ex1"), "", {}, {}};
-  result.summary = run_compare_command(model, options, filter_config(options), grid, context, out);
+  ExampleResult result = run_table_example("sunahara-ex1", model, settings, context, out);
   add_filter_rows(result.table, result.summary,
                   "QLF with the closed forms (6.4)-(6.5), i.e. (6.6)-(6.7); the general (5.27)/(5.29) give the same",
                   "SOF = Schwartz's filter (6.10)-(6.11) (Table 1-2 row [9]; h linear, so also row [12])");
@@ -86,10 +84,7 @@ ExampleResult reproduce_sunahara_ex1(const ReproduceSettings& settings, const Ru
 ExampleResult reproduce_sunahara_ex2(const ReproduceSettings& settings, const RunContext& context,
                                      const OutputDirectory& out) {
   const CubicOscillatorModel model;  // q = r = 0.5, truth from (1.5, 1.0), filters from N(0, I)
-  const CompareOptions options = stochastic_options(model.name, settings);
-  const TimeGrid grid = make_time_grid(options.run.T, options.run.dt, options.run.output_points);
-  ExampleResult result{ReproductionTable("sunahara-ex2"), "", {}, {}};
-  result.summary = run_compare_command(model, options, filter_config(options), grid, context, out);
+  ExampleResult result = run_table_example("sunahara-ex2", model, settings, context, out);
   add_filter_rows(result.table, result.summary,
                   "QLF = (6.16)-(6.17) (closed form (6.14), exact Gaussian moments of the cubic), gain P r^-2",
                   "SOF = Taylor-expansion filter (6.18)-(6.19), gain P r^-2");
@@ -102,6 +97,8 @@ ExampleResult reproduce_sunahara_ex2(const ReproduceSettings& settings, const Ru
   printed_options.trajectory_members.clear();
   printed_options.run.quiet = true;
   const OutputDirectory printed_out(out.path() / "printed-x0", "--out");
+  const TimeGrid grid =
+      make_time_grid(printed_options.run.T, printed_options.run.dt, printed_options.run.output_points);
   const nlohmann::json printed_summary =
       run_compare_command(printed, printed_options, filter_config(printed_options), grid, context, printed_out);
   result.summary["printed_x0"] = {{"x0_mean", {15.0, 10.0}},

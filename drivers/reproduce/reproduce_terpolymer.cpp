@@ -13,16 +13,7 @@ namespace kushner {
 ExampleResult reproduce_basin_terpolymer(const ReproduceSettings& settings, const RunContext& context,
                                          const OutputDirectory& out) {
   const TerpolymerModel model;  // all parameters 1, x(0) = 0, m(0) = 0.5, P(0) = I, q = 0, V = I
-  CompareOptions options;
-  options.run.model = model.name;
-  options.run.members = 1;
-  options.run.T = settings.T;
-  options.run.dt = settings.dt;
-  options.run.seed = settings.seed;
-  options.run.quiet = settings.quiet;
-  options.filters = "BILIN,MIXED,KBL";
-  options.trajectory_members = {0};
-  options.plots = false;  // drawn by the command once the reproduction table is written
+  const CompareOptions options = example_options(model.name, "BILIN,MIXED,KBL", 1, settings);
   const TimeGrid grid = make_time_grid(options.run.T, options.run.dt, options.run.output_points);
   ExampleResult result{ReproductionTable("basin-terpolymer"), "", {}, {}};
   result.summary = run_compare_with_truth(SineObservationNoise<TerpolymerModel>(model), model, options,
