@@ -11,18 +11,16 @@ small=(--members 12 --particles 256 --T 1 --dt 1e-2 --output-points 20 --quiet)
 
 run_kushner "$work/c" compare "${small[@]}" --out "$work/c1"
 [ "$rc" -eq 0 ] || fail "compare failed: $(cat "$work/c.err")"
-python=${KUSHNER_PYTHON:-python3}  # the interpreter kushner's plots use (drivers/plots.hpp)
-[ -n "${KUSHNER_PYTHON:-}" ] || [ ! -x /usr/bin/python3 ] || python=/usr/bin/python3
 artefacts=(summary.json timeseries.csv trajectories.csv density.csv report.md)
 figures=yes
-"$python" -c "import matplotlib" 2>/dev/null || figures=no  # e.g. the GPU machine
+can_draw_figures || figures=no  # e.g. the GPU machine
 [ $figures = no ] || artefacts+=(estimates.png estimates.svg errors.png rmse_ref.png density.png density.svg)
 for f in "${artefacts[@]}"; do
   [ -s "$work/c1/$f" ] || fail "compare did not write $f ($(grep -o '"plots_error": "[^"]*"' "$work/c1/summary.json"))"
 done
 if [ $figures = no ]; then  # report.md still comes, with its tables and why there are no figures
   grep -q "Not drawn: matplotlib is not installed" "$work/c1/report.md" || fail "report.md does not say why no figures"
-  echo "note: no matplotlib for $python, figures not checked"
+  echo "note: no matplotlib for $plot_python, figures not checked"
 fi
 ls "$work/c1" | grep -q '\.tmp' && fail "temporary files left behind"
 python3 - "$work/c1" <<'PY' || fail "compare summary.json or CSV files incomplete"

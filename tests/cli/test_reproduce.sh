@@ -19,8 +19,7 @@ for f in summary.json reproduction.csv reproduction.md report.md; do
   [ -s "$work/car/$f" ] || fail "reproduce basin-car-filter did not write $f"
 done
 figures=(estimates.png estimates.svg errors.png errors.svg rmse_ref.png rmse_ref.svg)
-plot_python=${KUSHNER_PYTHON:-$python}  # the interpreter kushner's plots use (drivers/plots.hpp)
-"$plot_python" -c "import matplotlib" 2>/dev/null || { figures=(); echo "note: no matplotlib for $plot_python, figures not checked"; }
+can_draw_figures || { figures=(); echo "note: no matplotlib for $plot_python, figures not checked"; }
 for run in taylor tan; do
   for f in summary.json timeseries.csv trajectories.csv report.md "${figures[@]}"; do
     [ -s "$work/car/$run/$f" ] || fail "reproduce basin-car-filter did not write $run/$f"
