@@ -95,7 +95,7 @@ BENCHMARK_TEMPLATE(BM_ParticleFilterStep, SineModel)->Apply([](benchmark::intern
   b->Args({100, 4096, 0, 1})->Args({1000, 1024, 0, 1})->Args({1000, 16384, 0, 1});
 #if defined(KOKKOS_ENABLE_CUDA)
   b->Args({1000, 65536, 0, 1})->Args({10000, 65536, 0, 1})->Args({15259, 65536, 0, 1});
-  b->Args({1000, 65536, 8, 1})->Args({1000, 65536, 16, 1})->Args({1000, 65536, 32, 1})->Args({1000, 65536, 0, 0});
+  b->Args({1000, 65536, 8, 1})->Args({1000, 65536, 32, 1})->Args({1000, 65536, 0, 0});
 #endif
 })->UseManualTime();
 BENCHMARK_TEMPLATE(BM_StreamCopy, SineModel)->Apply([](benchmark::internal::Benchmark* b) {

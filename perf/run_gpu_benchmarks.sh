@@ -15,7 +15,8 @@
 #   profile  Nsight Compute (ncu, where installed) on one launch of each step kernel at M = 1000, N = 65536:
 #            duration, throughput, occupancy, issue-slot use (ncu locks the clocks to base: durations are
 #            longer than in the benchmark)
-# The phases other than build only need build-cuda/: binaries built elsewhere (same CUDA major version) run.
+# The phases other than build only need build-cuda/ (or KUSHNER_BUILD_DIR): binaries built elsewhere (same CUDA
+# major version) run; perf/run_prebuilt_device.sh does that.
 # Where one call has a time limit, run the phases in separate calls, e.g.
 #   KUSHNER_PHASES=build ...; KUSHNER_PHASES=test ...; KUSHNER_PHASES=compare ...; KUSHNER_PHASES=sizes ...
 # Roughly: build 3-5 min at -j16, test 2-3 min, compare 3-4 min (torch.compile compiles first), sizes 3 min.
@@ -26,7 +27,7 @@ mkdir -p "$out"
 jobs=${KUSHNER_JOBS:-16}
 arch=${KUSHNER_CUDA_ARCH:-AMPERE80}
 reps=${KUSHNER_REPETITIONS:-10}
-build=$here/build-cuda
+build=${KUSHNER_BUILD_DIR:-$here/build-cuda}
 phases=" ${KUSHNER_PHASES:-build test compare sizes} "
 want() { [[ "$phases" == *" $1 "* ]]; }
 status=0
@@ -82,8 +83,8 @@ if want profile; then
       --launch-count 1 --section SpeedOfLight --section ComputeWorkloadAnalysis --section Occupancy \
       --section LaunchStats --section WarpStateStats --section InstructionStats \
       "$build/perf/bench_particle_filter" "$filter" --benchmark_repetitions=1 --benchmark_min_time=0.01
-    run ncu_posterior_resample ncu --kernel-name-base mangled --kernel-name regex:'ParticlePosterior|ParticleResampleStep' \
-      --launch-skip 600 --launch-count 6 --section SpeedOfLight \
+    run ncu_posterior_resample ncu --kernel-name-base mangled --kernel-name regex:'ParticlePosterior|Chunked|ParticleResampleStep' \
+      --launch-skip 600 --launch-count 8 --section SpeedOfLight \
       "$build/perf/bench_particle_filter" "$filter" --benchmark_repetitions=1 --benchmark_min_time=0.01
   else
     step "profile: no ncu on this machine"

@@ -1,10 +1,13 @@
 // Resampling schemes on fixed weight vectors: unbiased offspring counts (statistical, with a power check),
-// the residual scheme's deterministic part, and systematic indices identical on every backend and team size.
+// the residual scheme's deterministic part, systematic indices identical on every backend and team size, and
+// the particle filter's chunked systematic path identical to the one-team path.
+#include "kernels/particle_filter/chunked_systematic_resample.hpp"
 #include "kernels/particle_filter/resampling.hpp"
 #include "tests/test_spaces.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 namespace kushner {
@@ -162,6 +165,97 @@ TYPED_TEST(SystematicOnEveryBackend, IndicesIdenticalToHostSerialAndAcrossTeamSi
     for (int s : a) ++count[s];
     for (int j = 0; j < n; ++j) EXPECT_LE(std::abs(count[j] - n * w[j] / total), 1.0) << j;
   }
+}
+
+/// w(j, m) = exp(l(j, m) - log_normalizer(m)): the weights the one-team path starts from.
+template <class Mem>
+struct ExponentiatedWeights {
+  Kokkos::View<double**, Kokkos::LayoutLeft, Mem> l, w;
+  BankScalar<double, Mem> log_normalizer;
+  KOKKOS_INLINE_FUNCTION void operator()(const int j, const int m) const { w(j, m) = math::exp(l(j, m) - log_normalizer(m)); }
+};
+
+template <class Space>
+class ChunkedSystematic : public ::testing::Test {};
+TYPED_TEST_SUITE(ChunkedSystematic, test::ExecutionSpaces);
+
+/// Resamples the `listed` members of a bank of n particles by the chunked path and by the one-team path on
+/// the same backend: the same ancestors, the particles moved accordingly, and only the listed members changed.
+/// Log-weights with rounding everywhere and dead particles.
+template <class Space>
+void check_chunked_against_team_path(int n, int members, const std::vector<int>& listed) {
+  using Mem = typename Space::memory_space;
+  const std::uint32_t step = 17;
+  ChunkedResampleData<Mem> d;
+  d.x = ParticleBank<Mem>("x", n, members, 2);
+  d.x_scratch = ParticleBank<Mem>("x_scratch", n, members, 2);
+  d.log_weight = decltype(d.log_weight)("l", n, members);
+  d.ancestors = decltype(d.ancestors)("a", n, members);
+  d.block_sums = decltype(d.block_sums)("block_sums", scan_num_blocks(n), members);
+  d.log_normalizer = BankScalar<double, Mem>("log_normalizer", members);
+  d.members = Kokkos::View<int*, Mem>("members", members);
+  d.member_count = Kokkos::View<int, Mem>("member_count");
+  d.num_particles = n;
+  d.seed = seed;
+  d.step = step;
+  auto x = Kokkos::create_mirror(d.x);  // copies even on the host: the bank changes, these must not
+  auto l = Kokkos::create_mirror(d.log_weight);
+  auto log_normalizer = Kokkos::create_mirror(d.log_normalizer);
+  for (int m = 0; m < members; ++m) {
+    log_normalizer(m) = 3.0 + 0.1 * m;  // any value: the weights need not sum to one
+    for (int j = 0; j < n; ++j) {
+      l(j, m) = j % 13 == 5 ? -std::numeric_limits<double>::infinity()
+                            : -0.5 * std::pow((j - 0.34 * n - 300.0 * m) / (0.14 * n), 2) + 0.3 * std::sin(0.1 * j);
+      x(j, m, 0) = j + 1e7 * m;
+      x(j, m, 1) = -0.5 * j;
+    }
+  }
+  Kokkos::deep_copy(d.x, x);
+  Kokkos::deep_copy(d.log_weight, l);
+  Kokkos::deep_copy(d.log_normalizer, log_normalizer);
+  auto list = Kokkos::create_mirror_view(d.members);
+  for (std::size_t k = 0; k < listed.size(); ++k) list(k) = listed[k];
+  Kokkos::deep_copy(d.members, list);
+  Kokkos::deep_copy(d.member_count, static_cast<int>(listed.size()));
+
+  // The one-team path on the same backend: weights exp(l - log_normalizer), then resample_members.
+  ResamplingWorkspace<Mem> ws;
+  ws.cumulative = decltype(ws.cumulative)("w", n, members);
+  ws.ancestors = decltype(ws.ancestors)("a_team", n, members);
+  Kokkos::parallel_for(Kokkos::MDRangePolicy<Space, Kokkos::Rank<2>>({0, 0}, {n, members}),
+                       ExponentiatedWeights<Mem>{d.log_weight, ws.cumulative, d.log_normalizer});
+  resample_members(Space(), ws, ResamplingScheme::systematic, seed, step);
+
+  const bool host = std::is_same<Mem, Kokkos::HostSpace>::value;
+  chunked_systematic_resample<2>(Space(), d, host ? 1 : 256, host ? 3 : 64);
+  Space().fence();
+  const auto expected = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), ws.ancestors);
+  const auto ancestors = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), d.ancestors);
+  const auto x_after = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), d.x);
+  const auto l_after = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), d.log_weight);
+  const auto n_after = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), d.log_normalizer);
+  for (int m = 0; m < members; ++m) {
+    const bool resampled = std::find(listed.begin(), listed.end(), m) != listed.end();
+    EXPECT_EQ(n_after(m), resampled ? std::log(double(n)) : log_normalizer(m)) << m;
+    int mismatches = 0;
+    for (int s = 0; s < n; ++s) {
+      const int a = resampled ? expected(s, m) : s;
+      if (resampled && ancestors(s, m) != a) ++mismatches;
+      if (resampled) EXPECT_NE(l(a, m), -std::numeric_limits<double>::infinity()) << "dead particle drawn, member " << m;
+      EXPECT_EQ(x_after(s, m, 0), x(a, m, 0));
+      EXPECT_EQ(x_after(s, m, 1), x(a, m, 1));
+      EXPECT_EQ(l_after(s, m), resampled ? 0.0 : l(s, m));
+    }
+    EXPECT_EQ(mismatches, 0) << "member " << m;
+  }
+}
+
+TYPED_TEST(ChunkedSystematic, MatchesTheTeamPathAndMovesTheParticles) {
+  // Several chunks and a partial last one, members listed in a scrambled order.
+  check_chunked_against_team_path<TypeParam>(5003, 6, {3, 0, 5, 2});
+  // Over 2^20 particles: scan blocks of 269, which do not divide the chunk size.
+  ASSERT_EQ(scan_block_size(1100003), 269);
+  check_chunked_against_team_path<TypeParam>(1100003, 2, {1});
 }
 
 }  // namespace

@@ -9,14 +9,16 @@
 //   pf.posterior_mean();   // (member, i)
 //
 // A step is three kernels: propagate + weight + block moments (particle_step.hpp), per-member posterior
-// (particle_posterior.hpp), and resampling of the members whose ESS fell below threshold * N
-// (particle_resample_step.hpp). Every sum that reaches an output is taken in a fixed order, so a seed gives
+// (particle_posterior.hpp), and resampling of the members whose ESS fell below threshold * N: a team per
+// member (particle_resample_step.hpp), or, with the team kernel and systematic resampling (the GPU's
+// default), many teams per member (chunked_systematic_resample.hpp). Every sum that reaches an output is taken in a fixed order, so a seed gives
 // the same bits on 1 or 2 threads and on Serial or OpenMP; the GPU differs in the last bits of its math
 // library only.
 #include "kernels/bank.hpp"
 #include "kernels/errors.hpp"
 #include "kernels/for_each_member.hpp"
 #include "kernels/linear_algebra.hpp"
+#include "kernels/particle_filter/chunked_systematic_resample.hpp"
 #include "kernels/particle_filter/particle_posterior.hpp"
 #include "kernels/particle_filter/particle_resample_step.hpp"
 #include "kernels/particle_filter/particle_step.hpp"
@@ -80,7 +82,7 @@ class ParticleFilterBank {
     team_size_ = options.team_size > 0 ? options.team_size : (host_memory ? 1 : device_particle_team);
     const int per_thread = options.particles_per_thread > 0 ? options.particles_per_thread : device_particles_per_thread;
     // The team kernel on the host (tests) keeps 1024-particle chunks, so small tests still merge several.
-    block_size_ = use_team_ ? (host_memory ? device_particle_batch * device_particle_team : team_size_ * per_thread)
+    block_size_ = use_team_ ? (host_memory ? 1024 : team_size_ * per_thread)
                             : host_particle_block;
     num_blocks_ = (num_particles + block_size_ - 1) / block_size_;
     KUSHNER_REQUIRE(block_size_ % 2 == 0,
@@ -91,6 +93,13 @@ class ParticleFilterBank {
     x_scratch_ = ParticleBank<MemSpace>("kushner::particles_scratch", num_particles, num_members, n);
     workspace_.cumulative = decltype(workspace_.cumulative)("kushner::log_weights", num_particles, num_members);
     workspace_.ancestors = decltype(workspace_.ancestors)("kushner::ancestors", num_particles, num_members);
+    use_chunked_resample_ = use_team_ && options.scheme == ResamplingScheme::systematic &&
+                            chunked_resample_supports(num_particles);
+    if (use_chunked_resample_) {
+      resample_list_ = Kokkos::View<int*, MemSpace>("kushner::resample_list", num_members);
+      resample_list_size_ = Kokkos::View<int, MemSpace>("kushner::resample_list_size");
+      block_sums_ = decltype(block_sums_)("kushner::resample_block_sums", scan_num_blocks(num_particles), num_members);
+    }
     if (options.scheme == ResamplingScheme::residual)
       workspace_.copies = decltype(workspace_.copies)("kushner::offspring", num_particles, num_members);
     partials_ = decltype(partials_)("kushner::particle_partials", num_blocks_, num_members, WeightedMoments<n>::size);
@@ -175,6 +184,7 @@ class ParticleFilterBank {
     d.initial_root = Mat<Model::state_dim, Model::state_dim>::zero();
     d.t = t;
     d.dt = dt;
+    d.sqrt_dt = std::sqrt(dt);
     d.seed = seed_;
     d.step = step;
     d.num_particles = num_particles_;
@@ -191,11 +201,24 @@ class ParticleFilterBank {
     } else {
       run_host_block_kernel(d);
     }
+    if (use_chunked_resample_) Kokkos::deep_copy(space_, resample_list_size_, 0);
     parallel_for_members(
         "kushner::particle_posterior", space_, num_members_,
         ParticlePosterior<n, MemSpace>{partials_, num_blocks_, reference_, mean_, covariance_, ess_, log_normalizer_,
-                                       resample_, resample_count_, status_, options_.ess_threshold * num_particles_});
+                                       resample_, resample_count_, status_, options_.ess_threshold * num_particles_,
+                                       resample_list_, resample_list_size_});
     if (d.initialize) return;
+    if (use_chunked_resample_) {
+      const ChunkedResampleData<MemSpace> r{x_, x_scratch_, workspace_.cumulative, workspace_.ancestors, block_sums_,
+                                            log_normalizer_, resample_list_, resample_list_size_, num_particles_,
+                                            seed_, d.step};
+      // A fixed league loops over (member, chunk) items: the number of members to resample stays on the device.
+      const long items = static_cast<long>(num_members_) * resample_chunks(num_particles_);
+      const int league = static_cast<int>(items < chunked_resample_league ? items : chunked_resample_league);
+      constexpr bool host_memory = std::is_same<MemSpace, Kokkos::HostSpace>::value;
+      chunked_systematic_resample<n>(space_, r, host_memory ? team_size_ : device_chunked_resample_team, league);
+      return;
+    }
     if constexpr (!std::is_same<MemSpace, Kokkos::HostSpace>::value) {
       // A team per member, most of which return at once; the few that resample are latency-bound, so they
       // get big teams (the launch bound keeps the kernel within the registers 1024 threads have).
@@ -246,6 +269,10 @@ class ParticleFilterBank {
   int block_size_ = 0, num_blocks_ = 0, team_size_ = 1;
   ParticleBank<MemSpace> x_, x_scratch_;
   ResamplingWorkspace<MemSpace> workspace_;
+  bool use_chunked_resample_ = false;
+  Kokkos::View<int*, MemSpace> resample_list_;
+  Kokkos::View<int, MemSpace> resample_list_size_;
+  Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> block_sums_;
   Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace> partials_;
   BankScalar<double, MemSpace> log_normalizer_, ess_;
   BankVector<MemSpace> reference_, mean_;

@@ -22,6 +22,8 @@ struct ParticlePosterior {
   BankScalar<int, MemSpace> resample, resample_count;
   BankScalar<Status, MemSpace> status;
   double resample_below;                // resample when ESS < this (threshold * N)
+  Kokkos::View<int*, MemSpace> resample_list;  // if allocated: the resampled members, [0, resample_list_size())
+  Kokkos::View<int, MemSpace> resample_list_size;  // (in any order: each member's resampling is its own)
 
   KOKKOS_INLINE_FUNCTION void operator()(const int member) const {
     resample(member) = 0;
@@ -67,6 +69,7 @@ struct ParticlePosterior {
     if (ess(member) < resample_below) {
       resample(member) = 1;
       resample_count(member) += 1;
+      if (resample_list.extent(0) > 0) resample_list(Kokkos::atomic_fetch_add(&resample_list_size(), 1)) = member;
     }
   }
 };

@@ -38,19 +38,26 @@ namespace kushner {
 /// Particles per block of the host kernel: its arrays stay in L1, and the blocks of all members are the
 /// units of parallel work.
 constexpr int host_particle_block = 256;
-/// GPU teams: 256 threads, each taking 16 particles of the team's chunk in batches of 4 (the loads of a batch
-/// in flight together). Measured on an H100 at M = 1000, N = 65536 (perf/bench_particle_filter.cpp's
-/// per_thread argument): 4.44e10 particle-steps/s with 4 per thread, 4.71e10 with 8, 4.84e10 with 16; batches
-/// of 8 or 16 need more registers and ran slower.
+/// GPU teams: 256 threads, each taking 16 particles of the team's chunk one pair (one Philox block) at a time,
+/// the pair's loads in flight while its draws are computed. Measured on an H100 at M = 1000, N = 65536, fp64,
+/// with resampling (perf/particle_filter.md): batches of 2 particles 6.38e10 particle-steps/s, of 4 4.68e10
+/// (more registers under the 64-register bound); the next batch's loads issued ahead: 6.13e10; a pair's
+/// values moved as one 16-byte load/store: +0.5%, within the noise, not kept.
 constexpr int device_particle_team = 256;
 constexpr int device_particles_per_thread = 16;
-constexpr int device_particle_batch = 4;
+constexpr int device_particle_batch = 2;
 /// Launch bound of the team kernel: teams resident per multiprocessor (4 caps it at 64 registers; on an H100,
-/// 4 teams of 64 registers ran 18% faster than 2 of 106, bench_particle_filter, M = 1000, N = 65536).
+/// 4 teams of 64 registers ran 18% faster than 2 of 106, bench_particle_filter, M = 1000, N = 65536; batches of
+/// 4 with 3 teams (85 registers) ran 4% slower than batches of 2 with 4).
 constexpr int device_particle_teams_per_sm = 4;
-/// GPU teams of the resampling kernel: a resampled member's loops are latency-bound, so more threads help
-/// (1024 instead of 256: resampling went from 0.4 to 0.16 ms per step at M = 1000, N = 65536, on an H100).
+/// GPU teams of the one-team-per-member resampling kernel (schemes other than systematic): a resampled
+/// member's loops are latency-bound, so more threads help (1024 instead of 256: 0.4 -> 0.16 ms per step at
+/// M = 1000, N = 65536, on an H100).
 constexpr int device_resample_team = 1024;
+/// The chunked systematic resampling (chunked_systematic_resample.hpp): teams of 256 threads, at most 1024
+/// teams looping over the (member, chunk) items.
+constexpr int device_chunked_resample_team = 256;
+constexpr int chunked_resample_league = 1024;
 
 /// Everything one step reads and writes. Views are (particle, member[, i]) or (member[, i]), LayoutLeft.
 template <class Model, class MemSpace>
@@ -68,6 +75,7 @@ struct ParticleStepData {
   Vec<n> initial_mean;
   Mat<n, n> initial_root;           // any square root of the initial covariance
   double t = 0.0, dt = 0.0;
+  double sqrt_dt = 0.0;             // computed once: nvcc re-evaluated sqrt(dt) for every particle
   std::uint32_t seed = 0, step = 0;
   int num_particles = 0, block_size = 0;
   bool initialize = false;          // sample the initial law instead of propagating; no observation
@@ -111,7 +119,7 @@ KOKKOS_INLINE_FUNCTION double update_particle(const ParticleStepData<Model, MemS
       x = d.model.sample_exact_transition(d.t, x, d.dt, z, u);
     } else {
       const typename Model::Control control = Model::Control::zero();
-      x = x + d.model.drift(d.t, x, control) * d.dt + d.model.diffusion(d.t, x) * (z * math::sqrt(d.dt));
+      x = x + d.model.drift(d.t, x, control) * d.dt + d.model.diffusion(d.t, x) * (z * d.sqrt_dt);
     }
     const Vec<p> h = d.model.observation(d.t + d.dt, x);
     const double increment = dot(h, vinv_dy) - 0.5 * d.dt * dot(h, d.observation_precision * h);
@@ -312,11 +320,13 @@ struct ParticleTeamStep {
   }
 
   /// The particles [begin, end) of `member`, pairs (2 k, 2 k + 1) sharing their draws: thread `rank` takes
-  /// pairs begin / 2 + rank, + threads, ..., B at a time with all their loads issued first.
+  /// pairs begin / 2 + rank, + threads, ..., B at a time. A batch's loads are issued first and its draws
+  /// computed next (they need no memory), so the draws run while the loads are in flight.
   template <bool Initialize>
   KOKKOS_INLINE_FUNCTION void step_particles(int member, int begin, int end, int rank, int threads, const Vec<n>& ref,
                                              double shift, WeightedMoments<n>& w) const {
     constexpr int B = (P + 1) / 2;  // pairs per batch
+    constexpr int K = particle_draw_dim<Model, Initialize>;
     const double log_normalizer = Initialize ? 0.0 : d.log_normalizer(member);
     const Vec<p> vinv_dy = Initialize ? Vec<p>::zero() : precision_times_dy(d, member);
     double top = -positive_infinity();
@@ -339,32 +349,31 @@ struct ParticleTeamStep {
           lw[k] = Initialize ? 0.0 : lwm[j];
         }
       }
+      Vec<K> z[2 * B];
+      double u[2 * B];
       KUSHNER_DEVICE_UNROLL
       for (int b = 0; b < B; ++b) {
         const int pair = base + b * threads;
-        if (pair >= end_pair) continue;
-        constexpr int K = particle_draw_dim<Model, Initialize>;
-        Vec<K> z[2];
-        double u[2] = {0.0, 0.0};
         KUSHNER_DEVICE_UNROLL
         for (int i = 0; i < K; ++i) {
           const NormalPair zi = pair_normals<Random123Draws>(key, member, pair, step, i);
-          z[0][i] = zi.z0;
-          z[1][i] = zi.z1;
+          z[2 * b][i] = zi.z0;
+          z[2 * b + 1][i] = zi.z1;
         }
+        u[2 * b] = u[2 * b + 1] = 0.0;
         if constexpr (draws_uniform<Model, Initialize>)
-          pair_uniforms<Random123Draws>(key, member, pair, step, K, u[0], u[1]);
+          pair_uniforms<Random123Draws>(key, member, pair, step, K, u[2 * b], u[2 * b + 1]);
+      }
+      KUSHNER_DEVICE_UNROLL
+      for (int k = 0; k < 2 * B; ++k) {
+        const int j = 2 * (base + (k / 2) * threads) + k % 2;
+        if (j >= end) continue;
+        const double l = update_particle<Initialize>(d, z[k], u[k], lw[k], log_normalizer, vinv_dy, x[k]);
         KUSHNER_DEVICE_UNROLL
-        for (int h = 0; h < 2; ++h) {
-          const int j = 2 * pair + h, k = 2 * b + h;
-          if (j >= end) continue;
-          const double l = update_particle<Initialize>(d, z[h], u[h], lw[k], log_normalizer, vinv_dy, x[k]);
-          KUSHNER_DEVICE_UNROLL
-          for (int i = 0; i < n; ++i) xm[j + i * x_stride] = x[k][i];
-          lwm[j] = l;
-          top = l > top ? l : top;
-          add_particle(l - shift, x[k] - ref, w);
-        }
+        for (int i = 0; i < n; ++i) xm[j + i * x_stride] = x[k][i];
+        lwm[j] = l;
+        top = l > top ? l : top;
+        add_particle(l - shift, x[k] - ref, w);
       }
     }
     w.max_log_weight = top;
