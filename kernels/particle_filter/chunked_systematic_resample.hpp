@@ -56,22 +56,17 @@ struct ChunkedResampleData {
 
 namespace detail {
 
-/// Loops the team over work items (listed member, chunk), so a fixed league covers any number of members.
+/// Loops the team over work items (listed member, chunk), so a fixed league covers any number of members:
+/// body(member, begin, end) with the chunk's particles [begin, end), resample_chunk_blocks(n) whole scan blocks.
 template <class Team, class MemSpace, class Body>
 KOKKOS_INLINE_FUNCTION void for_each_chunk(const Team& team, const ChunkedResampleData<MemSpace>& d, const Body& body) {
-  const int chunks = resample_chunks(d.num_particles);
+  const int n = d.num_particles, chunks = resample_chunks(n), size = resample_chunk_blocks(n) * scan_block_size(n);
   const int items = d.member_count() * chunks;
   for (int item = team.league_rank(); item < items; item += team.league_size()) {
-    body(d.members(item / chunks), item % chunks);
+    const int begin = (item % chunks) * size;
+    body(d.members(item / chunks), begin, begin + size < n ? begin + size : n);
     team.team_barrier();  // the next item reuses the team's scratch
   }
-}
-
-/// Particles [begin, end) of the chunk: resample_chunk_blocks(n) whole scan blocks.
-KOKKOS_INLINE_FUNCTION void chunk_range(int n, int chunk, int& begin, int& end) {
-  const int size = resample_chunk_blocks(n) * scan_block_size(n);
-  begin = chunk * size;
-  end = begin + size < n ? begin + size : n;
 }
 
 /// The weights exp(l - log_normalizer) of particles [begin, end) into team scratch, loaded by the whole team.
@@ -97,11 +92,45 @@ KOKKOS_INLINE_FUNCTION double block_offset(const ChunkedResampleData<MemSpace>& 
   return offset;
 }
 
+/// For each work item: the chunk's weights into team scratch `w`, then, on one thread per scan block of the
+/// chunk, body(member, b, begin, lo, hi): block b, the chunk's first particle, the block's entries [lo, hi) of w.
+template <class Team, class MemSpace, class Scratch, class Body>
+KOKKOS_INLINE_FUNCTION void for_each_weight_block(const Team& team, const ChunkedResampleData<MemSpace>& d,
+                                                  const Scratch& w, const Body& body) {
+  for_each_chunk(team, d, [&](int member, int begin, int end) {
+    load_weights(team, d, member, begin, end, w);
+    const int block = scan_block_size(d.num_particles);
+    const int first_block = begin / block, blocks = (end - begin + block - 1) / block;
+    Kokkos::parallel_for(Kokkos::TeamThreadRange(team, blocks), [&](const int k) {
+      const int lo = k * block, hi = lo + block < end - begin ? lo + block : end - begin;
+      body(member, first_block + k, begin, lo, hi);
+    });
+  });
+}
+
+/// running + w(lo) + w(lo + 1) + ... + w(hi - 1), added in that order (blocked_inclusive_scan's), each
+/// partial sum handed to partial(j, sum); the loads of a batch are issued together.
+template <class Scratch, class Partial>
+KOKKOS_INLINE_FUNCTION double add_in_order(const Scratch& w, int lo, int hi, double running, const Partial& partial) {
+  for (int j0 = lo; j0 < hi; j0 += scan_batch) {
+    double v[scan_batch];
+    for (int i = 0; i < scan_batch; ++i) v[i] = j0 + i < hi ? w(j0 + i) : 0.0;
+    for (int i = 0; i < scan_batch; ++i)
+      if (j0 + i < hi) {
+        running += v[i];
+        partial(j0 + i, running);
+      }
+  }
+  return running;
+}
+
 }  // namespace detail
 
-/// Kernel 1: block_sums(b, member) = sum of the weights of scan block b, in particle order.
-template <class ExecSpace>
-struct ChunkedBlockSums {
+/// Kernels 1 and 2, blocked_inclusive_scan's two passes over each chunk. Pass 1 (Cumulative false):
+/// block_sums(b, member) = the sum of scan block b's weights in particle order. Pass 2: the cumulative weights
+/// C_j, from each block's offset, written over the log-weights.
+template <class ExecSpace, bool Cumulative>
+struct ChunkedScanPass {
   using MemSpace = typename ExecSpace::memory_space;
   using Team = typename Kokkos::TeamPolicy<ExecSpace>::member_type;
   using Scratch = Kokkos::View<double*, typename ExecSpace::scratch_memory_space, Kokkos::MemoryUnmanaged>;
@@ -109,56 +138,12 @@ struct ChunkedBlockSums {
 
   KOKKOS_INLINE_FUNCTION void operator()(const Team& team) const {
     const Scratch w(team.team_scratch(0), resample_chunk_particles);
-    detail::for_each_chunk(team, d, [&](int member, int chunk) {
-      int begin, end;
-      detail::chunk_range(d.num_particles, chunk, begin, end);
-      detail::load_weights(team, d, member, begin, end, w);
-      const int block = scan_block_size(d.num_particles);
-      const int first_block = begin / block, blocks = (end - begin + block - 1) / block;
-      Kokkos::parallel_for(Kokkos::TeamThreadRange(team, blocks), [&](const int k) {
-        const int lo = k * block, hi = lo + block < end - begin ? lo + block : end - begin;
-        double sum = 0.0;
-        for (int j0 = lo; j0 < hi; j0 += scan_batch) {
-          double v[scan_batch];
-          for (int i = 0; i < scan_batch; ++i) v[i] = j0 + i < hi ? w(j0 + i) : 0.0;
-          for (int i = 0; i < scan_batch; ++i)
-            if (j0 + i < hi) sum += v[i];
-        }
-        d.block_sums(first_block + k, member) = sum;
-      });
-    });
-  }
-};
-
-/// Kernel 2: the cumulative weights C_j of the chunk, written over its log-weights.
-template <class ExecSpace>
-struct ChunkedCumulative {
-  using MemSpace = typename ExecSpace::memory_space;
-  using Team = typename Kokkos::TeamPolicy<ExecSpace>::member_type;
-  using Scratch = Kokkos::View<double*, typename ExecSpace::scratch_memory_space, Kokkos::MemoryUnmanaged>;
-  ChunkedResampleData<MemSpace> d;
-
-  KOKKOS_INLINE_FUNCTION void operator()(const Team& team) const {
-    const Scratch w(team.team_scratch(0), resample_chunk_particles);
-    detail::for_each_chunk(team, d, [&](int member, int chunk) {
-      int begin, end;
-      detail::chunk_range(d.num_particles, chunk, begin, end);
-      detail::load_weights(team, d, member, begin, end, w);
-      const int block = scan_block_size(d.num_particles);
-      const int first_block = begin / block, blocks = (end - begin + block - 1) / block;
-      Kokkos::parallel_for(Kokkos::TeamThreadRange(team, blocks), [&](const int k) {
-        const int lo = k * block, hi = lo + block < end - begin ? lo + block : end - begin;
-        double running = detail::block_offset(d, member, first_block + k);
-        for (int j0 = lo; j0 < hi; j0 += scan_batch) {
-          double v[scan_batch];
-          for (int i = 0; i < scan_batch; ++i) v[i] = j0 + i < hi ? w(j0 + i) : 0.0;
-          for (int i = 0; i < scan_batch; ++i)
-            if (j0 + i < hi) {
-              running += v[i];
-              d.log_weight(begin + j0 + i, member) = running;
-            }
-        }
-      });
+    detail::for_each_weight_block(team, d, w, [&](int member, int b, int begin, int lo, int hi) {
+      if constexpr (Cumulative)
+        detail::add_in_order(w, lo, hi, detail::block_offset(d, member, b),
+                             [&](int j, double c) { d.log_weight(begin + j, member) = c; });
+      else
+        d.block_sums(b, member) = detail::add_in_order(w, lo, hi, 0.0, [](int, double) {});
     });
   }
 };
@@ -172,10 +157,8 @@ struct ChunkedSystematicScatter {
   ChunkedResampleData<MemSpace> d;
 
   KOKKOS_INLINE_FUNCTION void operator()(const Team& team) const {
-    detail::for_each_chunk(team, d, [&](int member, int chunk) {
+    detail::for_each_chunk(team, d, [&](int member, int begin, int end) {
       const int n = d.num_particles;
-      int begin, end;
-      detail::chunk_range(n, chunk, begin, end);
       const auto& c = d.log_weight;  // now the cumulative weights
       const double total = c(n - 1, member);
       const double u = detail::resampling_uniform(d.seed, member, 0, d.step);
@@ -203,14 +186,12 @@ struct ChunkedCopyBack {
   ChunkedResampleData<MemSpace> d;
 
   KOKKOS_INLINE_FUNCTION void operator()(const Team& team) const {
-    detail::for_each_chunk(team, d, [&](int member, int chunk) {
-      int begin, end;
-      detail::chunk_range(d.num_particles, chunk, begin, end);
+    detail::for_each_chunk(team, d, [&](int member, int begin, int end) {
       Kokkos::parallel_for(Kokkos::TeamThreadRange(team, begin, end), [&](const int s) {
         for (int i = 0; i < N; ++i) d.x(s, member, i) = d.x_scratch(s, member, i);
         d.log_weight(s, member) = 0.0;
       });
-      if (chunk == 0)
+      if (begin == 0)
         Kokkos::single(Kokkos::PerTeam(team),
                        [&]() { d.log_normalizer(member) = math::log(static_cast<double>(d.num_particles)); });
     });
@@ -228,10 +209,10 @@ void chunked_systematic_resample(const ExecSpace& space, const ChunkedResampleDa
   const std::size_t scratch = sizeof(double) * resample_chunk_particles;
   Kokkos::parallel_for("kushner::resample_block_sums",
                        Policy(space, league, team_size).set_scratch_size(0, Kokkos::PerTeam(scratch)),
-                       ChunkedBlockSums<ExecSpace>{d});
+                       ChunkedScanPass<ExecSpace, false>{d});
   Kokkos::parallel_for("kushner::resample_cumulative",
                        Policy(space, league, team_size).set_scratch_size(0, Kokkos::PerTeam(scratch)),
-                       ChunkedCumulative<ExecSpace>{d});
+                       ChunkedScanPass<ExecSpace, true>{d});
   Kokkos::parallel_for("kushner::resample_scatter", Policy(space, league, team_size),
                        ChunkedSystematicScatter<ExecSpace, N>{d});
   Kokkos::parallel_for("kushner::resample_copy_back", Policy(space, league, team_size), ChunkedCopyBack<ExecSpace, N>{d});
