@@ -8,12 +8,12 @@
 //   for (long k = 0; k < steps; ++k) { truth.step(k, dt); pf.step(k, dt, truth.observations()); }
 //   pf.posterior_mean();   // (member, i)
 //
-// A step is three kernels: propagate + weight + block moments (particle_step.hpp), per-member posterior
+// A step is three stages: propagate + weight + block moments (particle_step.hpp), per-member posterior
 // (particle_posterior.hpp), and resampling of the members whose ESS fell below threshold * N: a team per
 // member (particle_resample_step.hpp), or, with the team kernel and systematic resampling (the GPU's
-// default), many teams per member (chunked_systematic_resample.hpp). Every sum that reaches an output is taken in a fixed order, so a seed gives
-// the same bits on 1 or 2 threads and on Serial or OpenMP; the GPU differs in the last bits of its math
-// library only.
+// default), many teams per member (chunked_systematic_resample.hpp; the same indices). Every sum that
+// reaches an output is taken in a fixed order, so a seed gives the same bits on 1 or 2 threads and on Serial
+// or OpenMP; the GPU differs in the last bits of its math library only.
 #include "kernels/bank.hpp"
 #include "kernels/errors.hpp"
 #include "kernels/for_each_member.hpp"
