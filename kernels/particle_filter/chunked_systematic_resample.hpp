@@ -1,7 +1,7 @@
 #pragma once
 // Systematic resampling of the members that need it, spread over many teams per member: the particle
 // filter's resampling path on GPUs. A member of 65536 particles resampled by one team (one multiprocessor)
-// kept the rest of the GPU idle for ~0.1 ms per step; here every chunk of particles of every listed member is
+// kept the rest of the GPU idle for ~0.2 ms per step; here every chunk of particles of every listed member is
 // a work item, in four kernels:
 //   1. block sums:  w_j = exp(l_j - log_normalizer) summed sequentially over each scan block
 //   2. cumulative:  each block's cumulative weights C_j, from the prefix of the block sums, over the
@@ -13,7 +13,7 @@
 // version recomputed whole blocks of exp() in one thread and spent 0.1 ms per step there.
 // The sums are the ones blocked_inclusive_scan and resample_member compute (same blocks, same sequential
 // order, same expressions), so the indices are the same as the one-team path's on every backend; the test
-// ChunkedSystematicMatchesTheTeamPath checks it.
+// ChunkedSystematic.MatchesTheTeamPathAndMovesTheParticles (tests/test_resampling.cpp) checks it.
 #include "kernels/bank.hpp"
 #include "kernels/errors.hpp"
 #include "kernels/math.hpp"
