@@ -215,7 +215,8 @@ void chunked_systematic_resample(const ExecSpace& space, const ChunkedResampleDa
                        ChunkedScanPass<ExecSpace, true>{d});
   Kokkos::parallel_for("kushner::resample_scatter", Policy(space, league, team_size),
                        ChunkedSystematicScatter<ExecSpace, N>{d});
-  Kokkos::parallel_for("kushner::resample_copy_back", Policy(space, league, team_size), ChunkedCopyBack<ExecSpace, N>{d});
+  Kokkos::parallel_for("kushner::resample_copy_back", Policy(space, league, team_size),
+                       ChunkedCopyBack<ExecSpace, N>{d});
 }
 
 }  // namespace kushner
