@@ -9,8 +9,10 @@
 //   3. scatter:     particle j is copied into the slots s with g(C_{j-1}) <= s < g(C_j),
 //                   g(C) = ceil(N C / C_{N-1} - u)
 //   4. copy back:   the resampled particles return to the bank, with equal weights
-// Every thread's sequential chain is at most one scan block long (or the block sums before it): a first
-// version recomputed whole blocks of exp() in one thread and spent 0.1 ms per step there.
+// Every thread's sequential chain is at most one scan block long (or the block sums before it, read from team
+// scratch): a first version recomputed whole blocks of exp() in one thread and spent 0.1 ms per step there.
+// The kernels are latency-bound (a step resamples one or two members of a thousand), so each thread issues
+// the loads of its share of a chunk together: one memory latency per chunk, not one per particle.
 // The sums are the ones blocked_inclusive_scan and resample_member compute (same blocks, same sequential
 // order, same expressions), so the indices are the same as the one-team path's on every backend; the test
 // ChunkedSystematic.MatchesTheTeamPathAndMovesTheParticles (tests/test_resampling.cpp) checks it.
@@ -28,6 +30,9 @@ namespace kushner {
 
 /// Particles of a work item: whole scan blocks, at most this many (their weights live in team scratch).
 constexpr int resample_chunk_particles = 2048;
+
+/// Particles a thread loads at once: a chunk of 2048 is 8 per thread of a 256-thread team.
+constexpr int resample_batch = 8;
 
 /// Whether the chunked path handles members of n particles: its chunks hold whole scan blocks.
 KOKKOS_INLINE_FUNCTION constexpr bool chunked_resample_supports(int n) {
@@ -69,41 +74,59 @@ KOKKOS_INLINE_FUNCTION void for_each_chunk(const Team& team, const ChunkedResamp
   }
 }
 
+/// body(j0, stride) for each batch of the team's particles [begin, end): the thread's particles
+/// j0 + k stride, k < resample_batch (those below `end`), whose loads the body issues before it uses them.
+template <class Team, class Body>
+KOKKOS_INLINE_FUNCTION void for_each_batch(const Team& team, int begin, int end, const Body& body) {
+  const int threads = team.team_size();
+  for (int j0 = begin + team.team_rank(); j0 < end; j0 += resample_batch * threads) body(j0, threads);
+}
+
 /// The weights exp(l - log_normalizer) of particles [begin, end) into team scratch, loaded by the whole team.
 template <class Team, class MemSpace, class Scratch>
 KOKKOS_INLINE_FUNCTION void load_weights(const Team& team, const ChunkedResampleData<MemSpace>& d, int member,
                                          int begin, int end, const Scratch& w) {
   const double log_total = d.log_normalizer(member);
-  Kokkos::parallel_for(Kokkos::TeamThreadRange(team, begin, end),
-                       [&](const int j) { w(j - begin) = math::exp(d.log_weight(j, member) - log_total); });
+  for_each_batch(team, begin, end, [&](int j0, int stride) {
+    double l[resample_batch];
+    for (int k = 0; k < resample_batch; ++k) l[k] = j0 + k * stride < end ? d.log_weight(j0 + k * stride, member) : 0.0;
+    for (int k = 0; k < resample_batch; ++k)
+      if (j0 + k * stride < end) w(j0 + k * stride - begin) = math::exp(l[k] - log_total);
+  });
   team.team_barrier();
 }
 
-/// Sum of block_sums(0 .. b-1, member) in index order: blocked_inclusive_scan's exclusive prefix.
-template <class MemSpace>
-KOKKOS_INLINE_FUNCTION double block_offset(const ChunkedResampleData<MemSpace>& d, int member, int b) {
-  double offset = 0.0;
-  for (int b0 = 0; b0 < b; b0 += scan_batch) {
-    double v[scan_batch];
-    for (int k = 0; k < scan_batch; ++k) v[k] = b0 + k < b ? d.block_sums(b0 + k, member) : 0.0;
-    for (int k = 0; k < scan_batch; ++k)
-      if (b0 + k < b) offset += v[k];
-  }
-  return offset;
+/// offsets(k) = the sum of block_sums(0 .. first_block + k - 1, member) in index order (blocked_inclusive_scan's
+/// exclusive prefix), k < blocks. The block sums come into team scratch `sums` first, in one parallel load.
+template <class Team, class MemSpace, class Scratch>
+KOKKOS_INLINE_FUNCTION void block_offsets(const Team& team, const ChunkedResampleData<MemSpace>& d, int member,
+                                          int first_block, int blocks, const Scratch& sums, const Scratch& offsets) {
+  Kokkos::parallel_for(Kokkos::TeamThreadRange(team, first_block + blocks),
+                       [&](const int b) { sums(b) = d.block_sums(b, member); });
+  team.team_barrier();
+  Kokkos::parallel_for(Kokkos::TeamThreadRange(team, blocks), [&](const int k) {
+    double offset = 0.0;
+    for (int b = 0; b < first_block + k; ++b) offset += sums(b);
+    offsets(k) = offset;
+  });
+  team.team_barrier();
 }
 
 /// For each work item: the chunk's weights into team scratch `w`, then, on one thread per scan block of the
-/// chunk, body(member, b, begin, lo, hi): block b, the chunk's first particle, the block's entries [lo, hi) of w.
-template <class Team, class MemSpace, class Scratch, class Body>
+/// chunk, body(member, b, begin, lo, hi, offset): block b, the chunk's first particle, the block's entries
+/// [lo, hi) of w and (WithOffsets) the sum of the member's block sums before b, else 0. `w` has
+/// scan_num_blocks(n) entries at least; `offsets` resample_chunk_blocks(n).
+template <bool WithOffsets, class Team, class MemSpace, class Scratch, class Body>
 KOKKOS_INLINE_FUNCTION void for_each_weight_block(const Team& team, const ChunkedResampleData<MemSpace>& d,
-                                                  const Scratch& w, const Body& body) {
+                                                  const Scratch& w, const Scratch& offsets, const Body& body) {
   for_each_chunk(team, d, [&](int member, int begin, int end) {
-    load_weights(team, d, member, begin, end, w);
     const int block = scan_block_size(d.num_particles);
     const int first_block = begin / block, blocks = (end - begin + block - 1) / block;
+    if (WithOffsets) block_offsets(team, d, member, first_block, blocks, w, offsets);  // before w holds weights
+    load_weights(team, d, member, begin, end, w);
     Kokkos::parallel_for(Kokkos::TeamThreadRange(team, blocks), [&](const int k) {
       const int lo = k * block, hi = lo + block < end - begin ? lo + block : end - begin;
-      body(member, first_block + k, begin, lo, hi);
+      body(member, first_block + k, begin, lo, hi, WithOffsets ? offsets(k) : 0.0);
     });
   });
 }
@@ -136,12 +159,21 @@ struct ChunkedScanPass {
   using Scratch = Kokkos::View<double*, typename ExecSpace::scratch_memory_space, Kokkos::MemoryUnmanaged>;
   ChunkedResampleData<MemSpace> d;
 
+  /// Team scratch: the chunk's weights (or, before them, the member's block sums), then the blocks' offsets.
+  KOKKOS_INLINE_FUNCTION static int weights_size(int n) {
+    return scan_num_blocks(n) > resample_chunk_particles ? scan_num_blocks(n) : resample_chunk_particles;
+  }
+  static std::size_t scratch_bytes(int n) {
+    return Scratch::shmem_size(weights_size(n)) + Scratch::shmem_size(resample_chunk_blocks(n));
+  }
+
   KOKKOS_INLINE_FUNCTION void operator()(const Team& team) const {
-    const Scratch w(team.team_scratch(0), resample_chunk_particles);
-    detail::for_each_weight_block(team, d, w, [&](int member, int b, int begin, int lo, int hi) {
+    const int n = d.num_particles;
+    const Scratch w(team.team_scratch(0), weights_size(n)), offsets(team.team_scratch(0), resample_chunk_blocks(n));
+    detail::for_each_weight_block<Cumulative>(team, d, w, offsets, [&](int member, int b, int begin, int lo, int hi,
+                                                                        double offset) {
       if constexpr (Cumulative)
-        detail::add_in_order(w, lo, hi, detail::block_offset(d, member, b),
-                             [&](int j, double c) { d.log_weight(begin + j, member) = c; });
+        detail::add_in_order(w, lo, hi, offset, [&](int j, double c) { d.log_weight(begin + j, member) = c; });
       else
         d.block_sums(b, member) = detail::add_in_order(w, lo, hi, 0.0, [](int, double) {});
     });
@@ -162,16 +194,25 @@ struct ChunkedSystematicScatter {
       const auto& c = d.log_weight;  // now the cumulative weights
       const double total = c(n - 1, member);
       const double u = detail::resampling_uniform(d.seed, member, 0, d.step);
-      Kokkos::parallel_for(Kokkos::TeamThreadRange(team, begin, end), [&](const int j) {
-        const double lo = j > 0 ? c(j - 1, member) : 0.0, hi = c(j, member);
-        const int first = j == 0 ? 0 : detail::ceil_clamped((lo * n) / total - u, n);
-        const int last = j == n - 1 ? n : detail::ceil_clamped((hi * n) / total - u, n);
-        if (first >= last) return;
-        double v[N];
-        for (int i = 0; i < N; ++i) v[i] = d.x(j, member, i);
-        for (int s = first; s < last; ++s) {
-          d.ancestors(s, member) = j;
-          for (int i = 0; i < N; ++i) d.x_scratch(s, member, i) = v[i];
+      detail::for_each_batch(team, begin, end, [&](int j0, int stride) {
+        constexpr int B = resample_batch;
+        double lo[B], hi[B], v[B][N];
+        for (int k = 0; k < B; ++k) {
+          const int j = j0 + k * stride;
+          if (j >= end) continue;
+          lo[k] = j > 0 ? c(j - 1, member) : 0.0;
+          hi[k] = c(j, member);
+          for (int i = 0; i < N; ++i) v[k][i] = d.x(j, member, i);
+        }
+        for (int k = 0; k < B; ++k) {
+          const int j = j0 + k * stride;
+          if (j >= end) continue;
+          const int first = j == 0 ? 0 : detail::ceil_clamped((lo[k] * n) / total - u, n);
+          const int last = j == n - 1 ? n : detail::ceil_clamped((hi[k] * n) / total - u, n);
+          for (int s = first; s < last; ++s) {
+            d.ancestors(s, member) = j;
+            for (int i = 0; i < N; ++i) d.x_scratch(s, member, i) = v[k][i];
+          }
         }
       });
     });
@@ -187,9 +228,16 @@ struct ChunkedCopyBack {
 
   KOKKOS_INLINE_FUNCTION void operator()(const Team& team) const {
     detail::for_each_chunk(team, d, [&](int member, int begin, int end) {
-      Kokkos::parallel_for(Kokkos::TeamThreadRange(team, begin, end), [&](const int s) {
-        for (int i = 0; i < N; ++i) d.x(s, member, i) = d.x_scratch(s, member, i);
-        d.log_weight(s, member) = 0.0;
+      detail::for_each_batch(team, begin, end, [&](int s0, int stride) {
+        double v[resample_batch][N];
+        for (int k = 0; k < resample_batch; ++k)
+          if (s0 + k * stride < end)
+            for (int i = 0; i < N; ++i) v[k][i] = d.x_scratch(s0 + k * stride, member, i);
+        for (int k = 0; k < resample_batch; ++k)
+          if (s0 + k * stride < end) {
+            for (int i = 0; i < N; ++i) d.x(s0 + k * stride, member, i) = v[k][i];
+            d.log_weight(s0 + k * stride, member) = 0.0;
+          }
       });
       if (begin == 0)
         Kokkos::single(Kokkos::PerTeam(team),
@@ -206,7 +254,7 @@ void chunked_systematic_resample(const ExecSpace& space, const ChunkedResampleDa
   KUSHNER_REQUIRE(chunked_resample_supports(d.num_particles),
                   "chunked resampling: " << d.num_particles << " particles per member is more than it supports");
   using Policy = Kokkos::TeamPolicy<ExecSpace>;
-  const std::size_t scratch = sizeof(double) * resample_chunk_particles;
+  const std::size_t scratch = ChunkedScanPass<ExecSpace, false>::scratch_bytes(d.num_particles);
   Kokkos::parallel_for("kushner::resample_block_sums",
                        Policy(space, league, team_size).set_scratch_size(0, Kokkos::PerTeam(scratch)),
                        ChunkedScanPass<ExecSpace, false>{d});

@@ -195,8 +195,6 @@ class ParticleFilterBank {
   void run_step_kernels(const ParticleStepData<Model, MemSpace>& d) {
     constexpr int n = state_dim;
     if (use_team_) {
-      // Batches of 4 particles per thread, as many as the block holds (per_thread 16: four batches). Larger
-      // batches need more registers: 8 and 16 ran slower on an H100.
       run_team_kernel<device_particle_batch>(d);
     } else {
       run_host_block_kernel(d);
