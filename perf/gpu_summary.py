@@ -60,11 +60,26 @@ def report_sizes(out, source):
     return target
 
 
+def report_power(out):
+    """Median power draw and SM clock while the kushner step ran (power.csv, sampled by the compare phase)."""
+    try:
+        rows = [line.split(", ") for line in open(os.path.join(out, "power.csv")) if line.count(",") == 4]
+        rows = [r for r in rows if float(r[0]) > 0.5 * float(r[1])]  # busy samples only
+    except (OSError, ValueError):
+        return
+    if rows:
+        throttle = sorted({r[4].strip() for r in rows})
+        print(f"while kushner ran ({len(rows)} samples): power median {statistics.median(float(r[0]) for r in rows):.0f} W "
+              f"of {rows[0][1]} W, SM clock median {statistics.median(float(r[2]) for r in rows):.0f} MHz of "
+              f"{rows[0][3]} MHz, throttle reasons {' '.join(throttle)} (0x4: software power cap)")
+
+
 def main():
     out = sys.argv[1]
     gpu_csv = os.path.join(out, "gpu.csv")
     print("device: " + (open(gpu_csv).read().strip().splitlines()[-1] if os.path.exists(gpu_csv) else "?"))
     target = report_sizes(out, "bench_compare.json")
+    report_power(out)
     print("-- PyTorch, same call as bench_compare.json")
     for mode in ("eager", "compile"):
         t = load(os.path.join(out, f"torch_{mode}.json"))

@@ -9,8 +9,8 @@
 # KUSHNER_REPETITIONS (10), KUSHNER_PHASES (default "build test compare sizes"):
 #   build    configure and build build-cuda/ (kept between calls on the device machine)
 #   test     the particle-filter test binaries (device vs host, systematic indices, statistical references)
-#   compare  M = 1000, N = 65536: kushner's PF step and BM_StreamCopy, then PyTorch eager and torch.compile,
-#            in the same call (the side-by-side ratio)
+#   compare  M = 1000, N = 65536: kushner's PF step and BM_StreamCopy (with power draw and SM clock sampled),
+#            then PyTorch eager and torch.compile, in the same call (the side-by-side ratio)
 #   sizes    every size M.N = 4e5 .. 1e9 (5 repetitions) and Kokkos vs Thrust resampling
 #   profile  Nsight Compute (ncu, where installed) on one launch of each step kernel at M = 1000, N = 65536:
 #            duration, throughput, occupancy, issue-slot use (ncu locks the clocks to base: durations are
@@ -61,9 +61,15 @@ if want test; then
 fi
 
 if want compare; then
+  # Power draw, SM clock and throttle reasons every 100 ms during the kushner runs: at this size the H100 runs
+  # at its power limit, with the clock below its maximum (perf/particle_filter.md).
+  nvidia-smi --query-gpu=power.draw,power.limit,clocks.sm,clocks.max.sm,clocks_throttle_reasons.active \
+    --format=csv,noheader,nounits -lms 100 > "$out/power.csv" 2>/dev/null &
+  probe=$!
   run bench_compare "$build/perf/bench_particle_filter" --benchmark_filter='members:1000/particles:65536/' \
     --benchmark_repetitions="$reps" --benchmark_enable_random_interleaving=true \
     --benchmark_out="$out/bench_compare.json" --benchmark_out_format=json
+  kill $probe 2>/dev/null
   run torch_eager python3 "$here/perf/pf_torch.py" --mode eager --members 1000 --particles 65536 --repetitions "$reps"
   run torch_compile python3 "$here/perf/pf_torch.py" --mode compile --members 1000 --particles 65536 --repetitions "$reps"
   tail -n 1 "$out/torch_eager.log" > "$out/torch_eager.json" 2>/dev/null
