@@ -1,7 +1,8 @@
 // The whole particle-filter step (propagate, weight, block moments, posterior and ESS, amortized
 // resampling) in particle-steps per second, sine model, fp64, next to BM_StreamCopy of the bytes a step
 // must move (the memory floor) in the same binary. Observation increments come from a bank of truths that
-// is stepped outside the timed region.
+// is stepped outside the timed region. With steps = 2 each timed call is ParticleFilterBank::step_pair (two
+// steps, one pass over the particles on a GPU: half the bytes per particle-step).
 #include "drivers/simulate_ensemble.hpp"
 #include "kernels/particle_filter/particle_filter_bank.hpp"
 #include "models/sine_model.hpp"
@@ -33,6 +34,8 @@ void BM_ParticleFilterStep(benchmark::State& state) {
   if (state.range(3) == 0) options.ess_threshold = 0.0;  // never resample: the cost of the other kernels
   if (state.range(2) > 0) options.particles_per_thread = static_cast<int>(state.range(2));
   ParticleFilterBank<Space, Model> pf(space, model, members, particles, 43, options);
+  const bool pairs = state.range(4) == 2;
+  BankVector<typename Space::memory_space> first_dy("first_dy", members, Model::obs_dim);
   long k = 0;
   for (; k < warmup_steps; ++k) {
     truth.step(k, dt);
@@ -40,18 +43,25 @@ void BM_ParticleFilterStep(benchmark::State& state) {
   }
   for (auto _ : state) {
     truth.step(k, dt);
+    if (pairs) {
+      Kokkos::deep_copy(space, first_dy, truth.observations());
+      truth.step(k + 1, dt);
+    }
     space.fence();
     Kokkos::Timer timer;
-    pf.step(k, dt, truth.observations());
+    if (pairs) pf.step_pair(k, dt, first_dy, truth.observations());
+    else pf.step(k, dt, truth.observations());
     space.fence();
     state.SetIterationTime(timer.seconds());
-    ++k;
+    k += pairs ? 2 : 1;
   }
   using C = benchmark::Counter;
-  const double particle_steps = static_cast<double>(members) * particles;
+  const double particle_steps = static_cast<double>(members) * particles * (pairs ? 2 : 1);
   state.counters["particle_steps_per_s"] = C(particle_steps, C::kIsIterationInvariantRate);
-  state.counters["GB_per_s"] = C(1e-9 * bytes_per_particle_step<Model>() * particle_steps, C::kIsIterationInvariantRate);
-  state.counters["bytes_per_particle_step"] = bytes_per_particle_step<Model>();
+  // A fused pair reads and writes the particles once for two steps.
+  const double bytes = bytes_per_particle_step<Model>() / (pairs && pf.fuses_step_pairs() ? 2 : 1);
+  state.counters["GB_per_s"] = C(1e-9 * bytes * particle_steps, C::kIsIterationInvariantRate);
+  state.counters["bytes_per_particle_step"] = bytes;
   const auto counts = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pf.resample_count());
   const auto status = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pf.status());
   const auto mean = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pf.posterior_mean());
@@ -89,13 +99,16 @@ void BM_StreamCopy(benchmark::State& state) {
 
 // M x N: the CPU target (100 x 4096), then M.N = 1e6 .. 1e9; sizes past 1e7 only where a GPU runs them.
 // The third argument (GPU team kernel only) is particles per thread, 0 = the default; the fourth, 0, turns
-// resampling off (ESS threshold 0), which shows what resampling costs.
+// resampling off (ESS threshold 0), which shows what resampling costs; the fifth is steps per timed call
+// (2: step_pair, which fuses them where the team kernel runs).
 BENCHMARK_TEMPLATE(BM_ParticleFilterStep, SineModel)->Apply([](benchmark::internal::Benchmark* b) {
-  b->ArgNames({"members", "particles", "per_thread", "resample"});
-  b->Args({100, 4096, 0, 1})->Args({1000, 1024, 0, 1})->Args({1000, 16384, 0, 1});
+  b->ArgNames({"members", "particles", "per_thread", "resample", "steps"});
+  b->Args({100, 4096, 0, 1, 1})->Args({1000, 1024, 0, 1, 1})->Args({1000, 16384, 0, 1, 1});
 #if defined(KOKKOS_ENABLE_CUDA)
-  b->Args({1000, 65536, 0, 1})->Args({10000, 65536, 0, 1})->Args({15259, 65536, 0, 1});
-  b->Args({1000, 65536, 8, 1})->Args({1000, 65536, 32, 1})->Args({1000, 65536, 0, 0});
+  b->Args({1000, 65536, 0, 1, 1})->Args({10000, 65536, 0, 1, 1})->Args({15259, 65536, 0, 1, 1});
+  b->Args({1000, 65536, 8, 1, 1})->Args({1000, 65536, 32, 1, 1})->Args({1000, 65536, 0, 0, 1});
+  b->Args({1000, 65536, 0, 1, 2})->Args({1000, 65536, 0, 0, 2})->Args({1000, 1024, 0, 1, 2});
+  b->Args({1000, 16384, 0, 1, 2})->Args({10000, 65536, 0, 1, 2});
 #endif
 })->UseManualTime();
 BENCHMARK_TEMPLATE(BM_StreamCopy, SineModel)->Apply([](benchmark::internal::Benchmark* b) {

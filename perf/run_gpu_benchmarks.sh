@@ -84,7 +84,7 @@ fi
 
 if want profile; then
   if command -v ncu > /dev/null; then
-    filter='--benchmark_filter=BM_ParticleFilterStep.*members:1000/particles:65536/per_thread:0/resample:1/'
+    filter='--benchmark_filter=BM_ParticleFilterStep.*members:1000/particles:65536/per_thread:0/resample:1/steps:1/'
     run ncu_team_step ncu --kernel-name-base mangled --kernel-name regex:ParticleTeamStep --launch-skip 250 \
       --launch-count 1 --section SpeedOfLight --section ComputeWorkloadAnalysis --section Occupancy \
       --section LaunchStats --section WarpStateStats --section InstructionStats \

@@ -7,6 +7,7 @@
 #include "tests/test_spaces.hpp"
 
 #include <cmath>
+#include <string>
 #include <vector>
 
 namespace kushner {
@@ -132,16 +133,25 @@ INSTANTIATE_TEST_SUITE_P(HostAndTeam, ParticleKernels,
                          ::testing::Values(ParticleKernel::host_block, ParticleKernel::team),
                          [](const auto& info) { return info.param == ParticleKernel::team ? "team" : "host_block"; });
 
-/// Runs a sine bank for `steps` steps with truths from seed 7 and returns the posterior means (member-major).
+/// Runs a sine bank for `steps` steps with truths from seed 7 and returns the posterior means (member-major);
+/// with `pairs`, two steps per step_pair call (steps even).
 template <class Space>
 std::vector<double> run_sine(int members, int particles, int steps, ParticleFilterOptions options,
-                             std::vector<double>* covariance = nullptr, std::vector<double>* ess = nullptr) {
+                             std::vector<double>* covariance = nullptr, std::vector<double>* ess = nullptr,
+                             bool pairs = false) {
   SineModel model;
   TruthBank<Space, SineModel> truth(Space(), model, members, 7);
   ParticleFilterBank<Space, SineModel> pf(Space(), model, members, particles, seed, options);
-  for (int k = 0; k < steps; ++k) {
+  BankVector<typename Space::memory_space> first_dy("first_dy", members, 1);
+  for (int k = 0; k < steps; k += pairs ? 2 : 1) {
     truth.step(k, 1e-2);
-    pf.step(k, 1e-2, truth.observations());
+    if (!pairs) {
+      pf.step(k, 1e-2, truth.observations());
+      continue;
+    }
+    Kokkos::deep_copy(first_dy, truth.observations());
+    truth.step(k + 1, 1e-2);
+    pf.step_pair(k, 1e-2, first_dy, truth.observations());
   }
   Space().fence();
   const auto mean = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pf.posterior_mean());
@@ -176,7 +186,9 @@ TEST(ParticleFilterBank, TeamKernelAgreesWithHostBlockKernel) {
 TEST(ParticleFilterBank, TeamKernelResumsWhenTheWeightBoundIsFarOff) {
   // The team kernel sums exp(l - s) with s = dy^T V^-1 dy / (2 dt), the largest log-weight any particle could
   // get. A large dy puts s hundreds of nats above every particle's l: the kernel must notice and sum again
-  // relative to the largest l (member 1), and give what the host kernel (exact block maxima) gives.
+  // relative to the largest l (member 1), and give what the host kernel (exact block maxima) gives. Also for
+  // step_pair, with the outlier in the first step of a pair (summed again by recomputing that step) and in
+  // the second (from the stored particles).
   SineModel model;
   const int members = 3, particles = 3000;
   ParticleFilterOptions block, team;
@@ -185,23 +197,116 @@ TEST(ParticleFilterBank, TeamKernelResumsWhenTheWeightBoundIsFarOff) {
   team.kernel = ParticleKernel::team;
   ParticleFilterBank<Host, SineModel> pb(Host(), model, members, particles, seed, block);
   ParticleFilterBank<Host, SineModel> pt(Host(), model, members, particles, seed, team);
-  BankVector<Kokkos::HostSpace> dy("dy", members, 1);
-  for (int k = 0; k < 3; ++k) {
-    dy(0, 0) = 0.01;
-    dy(1, 0) = k == 1 ? 30.0 : 0.01;  // s - max l ~ 0.5 * 30^2 / 0.01 at step 1
-    dy(2, 0) = -0.02;
-    pb.step(k, 0.01, dy);
-    pt.step(k, 0.01, dy);
+  ParticleFilterBank<Host, SineModel> pp(Host(), model, members, particles, seed, team);
+  std::vector<BankVector<Kokkos::HostSpace>> dy;
+  for (int k = 0; k < 5; ++k) {
+    dy.emplace_back("dy", members, 1);
+    dy[k](0, 0) = 0.01;
+    dy[k](1, 0) = k == 1 || k == 4 ? 30.0 : 0.01;  // s - max l ~ 0.5 * 30^2 / 0.01 at steps 1 and 4
+    dy[k](2, 0) = -0.02;
   }
-  Host().fence();
-  for (int m = 0; m < members; ++m) {
-    ASSERT_EQ(pt.status()(m), Status::ok) << m;
-    EXPECT_NEAR(pt.posterior_mean()(m, 0), pb.posterior_mean()(m, 0), 1e-12 * (1 + std::abs(pb.posterior_mean()(m, 0)))) << m;
-    EXPECT_NEAR(pt.posterior_covariance()(m, 0), pb.posterior_covariance()(m, 0), 1e-12 * pb.posterior_covariance()(m, 0)) << m;
-    EXPECT_NEAR(pt.effective_sample_size()(m), pb.effective_sample_size()(m), 1e-10 * pb.effective_sample_size()(m)) << m;
-    EXPECT_NEAR(pt.log_normalizer()(m), pb.log_normalizer()(m), 1e-12 * (1 + std::abs(pb.log_normalizer()(m)))) << m;
+  auto expect_agree = [&](const ParticleFilterBank<Host, SineModel>& p, const char* which, int k) {
+    Host().fence();
+    for (int m = 0; m < members; ++m) {
+      ASSERT_EQ(p.status()(m), Status::ok) << which << " step " << k << " member " << m;
+      const double mean = pb.posterior_mean()(m, 0), cov = pb.posterior_covariance()(m, 0);
+      EXPECT_NEAR(p.posterior_mean()(m, 0), mean, 1e-12 * (1 + std::abs(mean))) << which << " step " << k << " member " << m;
+      EXPECT_NEAR(p.posterior_covariance()(m, 0), cov, 1e-12 * cov) << which << " step " << k << " member " << m;
+      EXPECT_NEAR(p.effective_sample_size()(m), pb.effective_sample_size()(m), 1e-10 * pb.effective_sample_size()(m))
+          << which << " step " << k << " member " << m;
+      // The normalized log-weights (step_pair leaves the stored ones relative to an earlier normalizer).
+      int worst = 0;
+      double worst_excess = -1.0;
+      for (int j = 0; j < particles; ++j) {
+        const double want = pb.log_weights()(j, m) - pb.log_normalizer()(m);
+        const double got = p.log_weights()(j, m) - p.log_normalizer()(m);
+        const double excess = std::abs(got - want) - 1e-12 * (1 + std::abs(pb.log_weights()(j, m)) +
+                                                               std::abs(pb.log_normalizer()(m)));
+        if (excess > worst_excess) worst_excess = excess, worst = j;
+      }
+      EXPECT_LE(worst_excess, 0.0) << which << " step " << k << " member " << m << " particle " << worst;
+    }
+  };
+  for (int k = 0; k < 5; ++k) {
+    pb.step(k, 0.01, dy[k]);
+    pt.step(k, 0.01, dy[k]);
+    if (k == 0) pp.step(k, 0.01, dy[k]);
+    if (k == 2 || k == 4) pp.step_pair(k - 1, 0.01, dy[k - 1], dy[k]);
+    expect_agree(pt, "step", k);
+    if (k == 1) EXPECT_LT(pt.effective_sample_size()(1), 0.1 * particles);  // the outlier did concentrate the weights
+    if (k % 2 == 0) expect_agree(pp, "step_pair", k);
   }
-  EXPECT_LT(pt.effective_sample_size()(1), 0.1 * particles);  // the outlying dy did concentrate the weights
+}
+
+/// Posterior mean, covariance and ESS of every member, and the resampling counts.
+struct PosteriorCopy {
+  std::vector<double> mean, covariance, ess;
+  std::vector<int> resamples;
+};
+template <class Bank, class Views>
+PosteriorCopy copy_posterior(const Bank& pf, const Views& v) {
+  Kokkos::fence();
+  PosteriorCopy c;
+  for (int m = 0; m < pf.num_members(); ++m) {
+    c.mean.push_back(v.mean(m, 0));
+    c.covariance.push_back(v.covariance(m, 0));
+    c.ess.push_back(v.ess(m));
+    c.resamples.push_back(pf.resample_count()(m));
+  }
+  return c;
+}
+void expect_close(const PosteriorCopy& got, const PosteriorCopy& want, const std::string& where) {
+  for (std::size_t m = 0; m < want.mean.size(); ++m) {
+    EXPECT_NEAR(got.mean[m], want.mean[m], 1e-12 * (1 + std::abs(want.mean[m]))) << where << " member " << m;
+    EXPECT_NEAR(got.covariance[m], want.covariance[m], 1e-12 * want.covariance[m]) << where << " member " << m;
+    EXPECT_NEAR(got.ess[m], want.ess[m], 1e-10 * want.ess[m]) << where << " member " << m;
+  }
+}
+
+TEST(ParticleFilterBank, StepPairMatchesTwoSteps) {
+  // step_pair's fused pass (team kernel and chunked systematic resampling, run here on the host) against
+  // step() twice, after both steps of every pair. With threshold 0.9 some members resample at nearly every
+  // step, so the redo of the members that a pair's first step resamples runs throughout. The sums differ in
+  // their shifts (the pass cannot normalize between its steps), so the results agree to rounding, not bits.
+  using Bank = ParticleFilterBank<Host, SineModel>;
+  SineModel model;
+  const int members = 16, particles = 2000, steps = 60;
+  ParticleFilterOptions options;
+  options.kernel = ParticleKernel::team;
+  options.ess_threshold = 0.9;
+  options.team_size = std::min(2, Host::concurrency());
+  TruthBank<Host, SineModel> truth(Host(), model, members, 7);
+  Bank single(Host(), model, members, particles, seed, options);
+  Bank paired(Host(), model, members, particles, seed, options);
+  ParticleFilterOptions block = options;  // the host kernel: step_pair is step() twice
+  block.kernel = ParticleKernel::host_block;
+  Bank unfused(Host(), model, members, particles, seed, block);
+  ASSERT_TRUE(paired.fuses_step_pairs());
+  ASSERT_FALSE(unfused.fuses_step_pairs());
+  BankVector<Kokkos::HostSpace> first_dy("first_dy", members, 1);
+  auto current = [](const Bank& pf) {
+    return copy_posterior(pf, Bank::PosteriorViews{pf.posterior_mean(), pf.posterior_covariance(),
+                                                   pf.effective_sample_size()});
+  };
+  int redone_pairs = 0;
+  for (int k = 0; k < steps; k += 2) {
+    truth.step(k, 1e-2);
+    Kokkos::deep_copy(first_dy, truth.observations());
+    single.step(k, 1e-2, first_dy);
+    const PosteriorCopy first = current(single);
+    truth.step(k + 1, 1e-2);
+    single.step(k + 1, 1e-2, truth.observations());
+    paired.step_pair(k, 1e-2, first_dy, truth.observations());
+    unfused.step_pair(k, 1e-2, first_dy, truth.observations());
+    for (const Bank* pf : {&paired, &unfused}) {
+      const std::string which = pf == &paired ? "fused, step " : "unfused, step ";
+      expect_close(copy_posterior(*pf, pf->first_step()), first, which + std::to_string(k));
+      expect_close(current(*pf), current(single), which + std::to_string(k + 1));
+    }
+    EXPECT_EQ(current(paired).resamples, current(single).resamples) << "step " << k + 1;
+    for (int m = 0; m < members; ++m) redone_pairs += first.ess[m] < options.ess_threshold * particles;
+  }
+  EXPECT_GT(redone_pairs, steps / 2);  // the redo path did run
 }
 
 TEST(ParticleFilterBank, RejectsBadSizesAndThresholds) {
@@ -227,11 +332,18 @@ TEST(ParticleFilterBank, DeviceMatchesHostToTwelveDigits) {
     options.scheme = scheme;
     std::vector<double> ch, cd, eh, ed;
     const auto mh = run_sine<Kokkos::DefaultHostExecutionSpace>(12, 5000, 150, options, &ch, &eh);
-    const auto md = run_sine<Kokkos::Cuda>(12, 5000, 150, options, &cd, &ed);
-    for (int m = 0; m < 12; ++m) {
-      EXPECT_NEAR(md[m], mh[m], 1e-12 * std::abs(mh[m]) + 1e-14) << to_string(scheme) << " member " << m;
-      EXPECT_NEAR(cd[m], ch[m], 1e-12 * ch[m]) << to_string(scheme) << " member " << m;
-      EXPECT_NEAR(ed[m], eh[m], 1e-12 * eh[m]) << to_string(scheme) << " member " << m;
+    // Systematic twice: step() and step_pair (the fused pass) on the GPU, each against step() on the host.
+    for (bool pairs : {false, true}) {
+      if (pairs && scheme != ResamplingScheme::systematic) continue;
+      const auto md = run_sine<Kokkos::Cuda>(12, 5000, 150, options, &cd, &ed, pairs);
+      const std::string what = std::string(to_string(scheme)) + (pairs ? " step_pair" : "");
+      for (int m = 0; m < 12; ++m) {
+        EXPECT_NEAR(md[m], mh[m], 1e-12 * std::abs(mh[m]) + 1e-14) << what << " member " << m;
+        EXPECT_NEAR(cd[m], ch[m], 1e-12 * ch[m]) << what << " member " << m;
+        EXPECT_NEAR(ed[m], eh[m], 1e-12 * eh[m]) << what << " member " << m;
+      }
+      cd.clear();
+      ed.clear();
     }
   }
 }

@@ -14,11 +14,15 @@
 // default), many teams per member (chunked_systematic_resample.hpp; the same indices). Every sum that
 // reaches an output is taken in a fixed order, so a seed gives the same bits on 1 or 2 threads and on Serial
 // or OpenMP; the GPU differs in the last bits of its math library only.
+//
+// step_pair takes two steps with one pass over the particles where the team kernel and the chunked
+// resampling run (the GPU's default): see step_pair.
 #include "kernels/bank.hpp"
 #include "kernels/errors.hpp"
 #include "kernels/for_each_member.hpp"
 #include "kernels/linear_algebra.hpp"
 #include "kernels/particle_filter/chunked_systematic_resample.hpp"
+#include "kernels/particle_filter/copy_listed_members.hpp"
 #include "kernels/particle_filter/particle_posterior.hpp"
 #include "kernels/particle_filter/particle_resample_step.hpp"
 #include "kernels/particle_filter/particle_step.hpp"
@@ -31,6 +35,7 @@
 #include <cmath>
 #include <cstdint>
 #include <type_traits>
+#include <utility>
 
 namespace kushner {
 
@@ -134,6 +139,83 @@ class ParticleFilterBank {
     run_step_kernels(step_data(k * dt, dt, static_cast<std::uint32_t>(k), dy));
   }
 
+  /// Steps k and k + 1 (increments dy, then dy_next): the same results as step(k) then step(k + 1), apart
+  /// from the last bits of the sums. With the team kernel and systematic resampling (the GPU's default) the
+  /// particles go through memory once for both steps: ParticleTeamStep<..., 2> reads the bank and writes a
+  /// second one, and the members that step k resamples (whose step k + 1 used the wrong particles) are stepped
+  /// again from the untouched first bank: step k, resampling, step k + 1, on the listed members only.
+  /// Otherwise it is the two steps. Afterwards the posterior accessors give step k + 1 and first_step()
+  /// step k.
+  void step_pair(long k, double dt, const BankVector<MemSpace>& dy, const BankVector<MemSpace>& dy_next) {
+    KUSHNER_REQUIRE(k >= 0 && k + 1 < (1L << 32), "steps " << k << ", " << k + 1 << " outside the counter range");
+    allocate_first_step();
+    if (!use_chunked_resample_) {
+      step(k, dt, dy);
+      Kokkos::deep_copy(space_, first_.mean, mean_);
+      Kokkos::deep_copy(space_, first_.covariance, covariance_);
+      Kokkos::deep_copy(space_, first_.ess, ess_);
+      step(k + 1, dt, dy_next);
+      return;
+    }
+    for (const auto* v : {&dy, &dy_next})
+      KUSHNER_REQUIRE(v->extent_int(0) == num_members_ && v->extent_int(1) == Model::obs_dim,
+                      "dy has shape (" << v->extent(0) << ", " << v->extent(1) << "), expected (" << num_members_
+                                       << ", " << Model::obs_dim << ")");
+    if (x_next_.extent(0) == 0) {
+      x_next_ = ParticleBank<MemSpace>("kushner::particles_next", num_particles_, num_members_, state_dim);
+      log_weight_next_ = decltype(log_weight_next_)("kushner::log_weights_next", num_particles_, num_members_);
+      partials_next_ = decltype(partials_next_)("kushner::particle_partials_next", num_blocks_, num_members_,
+                                                WeightedMoments<state_dim>::size);
+    }
+    const auto first = static_cast<std::uint32_t>(k), second = first + 1;
+    ParticleStepData<Model, MemSpace> d = step_data(k * dt, dt, first, dy);
+    d.x_out = x_next_;
+    d.log_weight_out = log_weight_next_;
+    d.dy_next = dy_next;
+    d.partials_next = partials_next_;
+    d.observation_precision_next = observation_precision((k + 1) * dt);
+    d.t_next = (k + 1) * dt;
+    run_team_kernel<device_particle_batch, 2>(d);
+    // The pass's output becomes the bank; its input (step k - 1's particles) stays for the redo.
+    std::swap(x_, x_next_);
+    std::swap(workspace_.cumulative, log_weight_next_);
+    // Step k's posterior. The reference point and log-normalizer stay step k - 1's: both steps of the pass
+    // were taken relative to them.
+    Kokkos::deep_copy(space_, resample_list_size_, 0);
+    run_posterior(partials_, first_, first_log_normalizer_, false);
+    // The members step k resamples: copy their step k - 1 particles back, step k, resample, step k + 1.
+    const long copy_items = static_cast<long>(num_members_) * num_particles_;
+    copy_listed_members<state_dim>(space_, CopyListedMembers<state_dim, MemSpace>{
+        x_next_, x_, log_weight_next_, workspace_.cumulative, resample_list_, resample_list_size_, num_particles_,
+        copy_items < listed_work_items ? copy_items : listed_work_items});
+    ParticleStepData<Model, MemSpace> redo = step_data(k * dt, dt, first, dy);
+    redo.members = resample_list_;
+    redo.member_count = resample_list_size_;
+    run_team_kernel<device_particle_batch, 1, true>(redo);
+    resample_listed(first_log_normalizer_, first);
+    redo = step_data((k + 1) * dt, dt, second, dy_next);
+    redo.members = resample_list_;
+    redo.member_count = resample_list_size_;
+    redo.log_normalizer = first_log_normalizer_;  // log N after the resampling
+    redo.partials = partials_next_;
+    run_team_kernel<device_particle_batch, 1, true>(redo);
+    // Step k + 1's posterior and resampling, as in step().
+    Kokkos::deep_copy(space_, resample_list_size_, 0);
+    run_posterior(partials_next_, current_posterior(), log_normalizer_, true);
+    resample_listed(log_normalizer_, second);
+  }
+
+  /// The posterior after the first step of the last step_pair (allocated by the first step_pair): (member, i),
+  /// (member, packed), (member).
+  struct PosteriorViews {
+    BankVector<MemSpace> mean;
+    BankSymmetric<MemSpace> covariance;
+    BankScalar<double, MemSpace> ess;
+  };
+  const PosteriorViews& first_step() const { return first_; }
+  /// Whether step_pair takes its two steps in one pass over the particles (else it is two steps).
+  bool fuses_step_pairs() const { return use_chunked_resample_; }
+
   int num_members() const { return num_members_; }
   int num_particles() const { return num_particles_; }
   const ParticleFilterOptions& options() const { return options_; }
@@ -164,9 +246,17 @@ class ParticleFilterBank {
   const BankScalar<double, MemSpace>& log_normalizer() const { return log_normalizer_; }
 
  private:
+  /// (R R^T)^{-1} at t.
+  Mat<Model::obs_dim, Model::obs_dim> observation_precision(double t) const {
+    constexpr int p = Model::obs_dim;
+    const Mat<p, p> r = model_.observation_noise(t);
+    Mat<p, p> root;
+    KUSHNER_REQUIRE(cholesky(r * transpose(r), root), Model::name << ": observation noise R R^T not positive definite at t=" << t);
+    return cholesky_inverse(root);
+  }
+
   ParticleStepData<Model, MemSpace> step_data(double t, double dt, std::uint32_t step,
                                               const BankVector<MemSpace>& dy) const {
-    constexpr int p = Model::obs_dim;
     ParticleStepData<Model, MemSpace> d;
     d.model = model_;
     d.x = x_;
@@ -176,10 +266,7 @@ class ParticleFilterBank {
     d.dy = dy;
     d.status = status_;
     d.partials = partials_;
-    const Mat<p, p> r = model_.observation_noise(t);
-    Mat<p, p> root;
-    KUSHNER_REQUIRE(cholesky(r * transpose(r), root), Model::name << ": observation noise R R^T not positive definite at t=" << t);
-    d.observation_precision = cholesky_inverse(root);
+    d.observation_precision = observation_precision(t);
     d.initial_mean = Vec<Model::state_dim>::zero();
     d.initial_root = Mat<Model::state_dim, Model::state_dim>::zero();
     d.t = t;
@@ -200,21 +287,10 @@ class ParticleFilterBank {
       run_host_block_kernel(d);
     }
     if (use_chunked_resample_) Kokkos::deep_copy(space_, resample_list_size_, 0);
-    parallel_for_members(
-        "kushner::particle_posterior", space_, num_members_,
-        ParticlePosterior<n, MemSpace>{partials_, num_blocks_, reference_, mean_, covariance_, ess_, log_normalizer_,
-                                       resample_, resample_count_, status_, options_.ess_threshold * num_particles_,
-                                       resample_list_, resample_list_size_});
+    run_posterior(partials_, current_posterior(), log_normalizer_, true);
     if (d.initialize) return;
     if (use_chunked_resample_) {
-      const ChunkedResampleData<MemSpace> r{x_, x_scratch_, workspace_.cumulative, workspace_.ancestors, block_sums_,
-                                            log_normalizer_, resample_list_, resample_list_size_, num_particles_,
-                                            seed_, d.step};
-      // A fixed league loops over (member, chunk) items: the number of members to resample stays on the device.
-      const long items = static_cast<long>(num_members_) * resample_chunks(num_particles_);
-      const int league = static_cast<int>(items < chunked_resample_league ? items : chunked_resample_league);
-      constexpr bool host_memory = std::is_same<MemSpace, Kokkos::HostSpace>::value;
-      chunked_systematic_resample<n>(space_, r, host_memory ? team_size_ : device_chunked_resample_team, league);
+      resample_listed(log_normalizer_, d.step);
       return;
     }
     if constexpr (!std::is_same<MemSpace, Kokkos::HostSpace>::value) {
@@ -235,17 +311,60 @@ class ParticleFilterBank {
                                                             num_particles_, options_.scheme, seed_, d.step});
   }
 
-  template <int Batch>
+  /// The posterior of a step from its block partials, into `out` and `log_normalizer`; resampling decisions
+  /// and counts, and the list of members to resample, into the bank's.
+  void run_posterior(const Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace>& partials, const PosteriorViews& out,
+                     const BankScalar<double, MemSpace>& log_normalizer, bool update_reference) {
+    parallel_for_members(
+        "kushner::particle_posterior", space_, num_members_,
+        ParticlePosterior<state_dim, MemSpace>{partials, num_blocks_, reference_, update_reference, out.mean,
+                                               out.covariance, out.ess, log_normalizer, resample_, resample_count_,
+                                               status_, options_.ess_threshold * num_particles_, resample_list_,
+                                               resample_list_size_});
+  }
+
+  PosteriorViews current_posterior() const { return {mean_, covariance_, ess_}; }
+
+  /// Chunked systematic resampling of the listed members at `step`, from the log-weights less `log_normalizer`.
+  void resample_listed(const BankScalar<double, MemSpace>& log_normalizer, std::uint32_t step) {
+    const ChunkedResampleData<MemSpace> r{x_, x_scratch_, workspace_.cumulative, workspace_.ancestors, block_sums_,
+                                          log_normalizer, resample_list_, resample_list_size_, num_particles_,
+                                          seed_, step};
+    // A fixed league loops over (member, chunk) items: the number of members to resample stays on the device.
+    const long items = static_cast<long>(num_members_) * resample_chunks(num_particles_);
+    const int league = static_cast<int>(items < chunked_resample_league ? items : chunked_resample_league);
+    constexpr bool host_memory = std::is_same<MemSpace, Kokkos::HostSpace>::value;
+    chunked_systematic_resample<state_dim>(space_, r, host_memory ? team_size_ : device_chunked_resample_team,
+                                           league);
+  }
+
+  void allocate_first_step() {
+    if (first_.mean.extent(0) > 0) return;
+    first_ = {BankVector<MemSpace>("kushner::particle_mean_first", num_members_, state_dim),
+              BankSymmetric<MemSpace>("kushner::particle_covariance_first", num_members_, packed_size(state_dim)),
+              BankScalar<double, MemSpace>("kushner::ess_first", num_members_)};
+    first_log_normalizer_ = BankScalar<double, MemSpace>("kushner::log_normalizer_first", num_members_);
+  }
+
+  /// The team kernel: a team per (chunk, member), or (Listed) a fixed league over the chunks of the members
+  /// in d.members. Launched with its arguments as kernel parameters (Kokkos' light-weight hint): the functor
+  /// is over the 512 bytes below which Kokkos does that by default, and copies larger ones to constant memory
+  /// first.
+  template <int Batch, int Steps = 1, bool Listed = false>
   void run_team_kernel(const ParticleStepData<Model, MemSpace>& d) {
-    using Kernel = ParticleTeamStep<Model, ExecSpace, Batch>;
+    using Kernel = ParticleTeamStep<Model, ExecSpace, Batch, Steps, Listed>;
+    using LightWeight = Kokkos::Experimental::WorkItemProperty::HintLightWeight_t;
+    const long items = static_cast<long>(num_blocks_) * num_members_;
+    const int league = static_cast<int>(!Listed || items < listed_league ? items : listed_league);
     if (team_size_ == device_particle_team) {  // measured best on an H100: 4 teams (64 registers) per SM
-      Kokkos::TeamPolicy<ExecSpace, Kokkos::LaunchBounds<device_particle_team, device_particle_teams_per_sm>> policy(
-          space_, num_blocks_ * num_members_, team_size_);
+      Kokkos::TeamPolicy<ExecSpace, Kokkos::LaunchBounds<device_particle_team, device_particle_teams_per_sm>,
+                         LightWeight>
+          policy(space_, league, team_size_);
       policy.set_scratch_size(0, Kokkos::PerTeam(Kernel::scratch_bytes(team_size_)));
       Kokkos::parallel_for("kushner::particle_team_step", policy, Kernel{d, num_blocks_});
       return;
     }
-    Kokkos::TeamPolicy<ExecSpace> policy(space_, num_blocks_ * num_members_, team_size_);
+    Kokkos::TeamPolicy<ExecSpace, LightWeight> policy(space_, league, team_size_);
     policy.set_scratch_size(0, Kokkos::PerTeam(Kernel::scratch_bytes(team_size_)));
     Kokkos::parallel_for("kushner::particle_team_step", policy, Kernel{d, num_blocks_});
   }
@@ -265,8 +384,17 @@ class ParticleFilterBank {
   int num_members_, num_particles_;
   bool use_team_ = false;
   int block_size_ = 0, num_blocks_ = 0, team_size_ = 1;
+  // Fixed leagues of the kernels that loop over the listed members (their number stays on the device).
+  static constexpr int listed_league = 1024;
+  static constexpr long listed_work_items = 1L << 18;
   ParticleBank<MemSpace> x_, x_scratch_;
   ResamplingWorkspace<MemSpace> workspace_;
+  // step_pair: the second bank, the second step's partials, step k's posterior.
+  ParticleBank<MemSpace> x_next_;
+  Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> log_weight_next_;
+  Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace> partials_next_;
+  PosteriorViews first_;
+  BankScalar<double, MemSpace> first_log_normalizer_;
   bool use_chunked_resample_ = false;
   Kokkos::View<int*, MemSpace> resample_list_;
   Kokkos::View<int, MemSpace> resample_list_size_;

@@ -16,6 +16,7 @@ struct ParticlePosterior {
   Kokkos::View<const double***, Kokkos::LayoutLeft, MemSpace> partials;  // (block, member, k)
   int num_blocks;
   BankVector<MemSpace> reference;       // (member, i): in, the step's reference point; out, the new mean
+  bool update_reference;                // false: leave the reference point (the first step of a fused pair)
   BankVector<MemSpace> mean;            // (member, i)
   BankSymmetric<MemSpace> covariance;   // (member, packed)
   BankScalar<double, MemSpace> ess, log_normalizer;
@@ -61,7 +62,7 @@ struct ParticlePosterior {
     for (int i = 0; i < N; ++i) {
       const double m = reference(member, i) + mean_dx[i];
       mean(member, i) = m;
-      reference(member, i) = m;
+      if (update_reference) reference(member, i) = m;
     }
     for (int k = 0; k < packed; ++k) covariance(member, k) = cov[k];
     ess(member) = w.sum_weight * w.sum_weight / w.sum_weight_sq;

@@ -79,6 +79,17 @@ struct ParticleStepData {
   std::uint32_t seed = 0, step = 0;
   int num_particles = 0, block_size = 0;
   bool initialize = false;          // sample the initial law instead of propagating; no observation
+  // Team kernel only. If `members` is allocated, only members(0 .. member_count() - 1) take the step.
+  Kokkos::View<const int*, MemSpace> members;
+  Kokkos::View<const int, MemSpace> member_count;
+  // The second step of a fused pair (ParticleTeamStep<..., 2>), step + 1 over [t_next, t_next + dt]. A pair reads
+  // x and log_weight and writes x_out and log_weight_out (same layout), so its first step can be recomputed.
+  ParticleBank<MemSpace> x_out;
+  Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> log_weight_out;
+  BankVector<MemSpace> dy_next;
+  Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace> partials_next;
+  Mat<p, p> observation_precision_next;
+  double t_next = 0.0;
 };
 
 /// Draws per particle and step: the normals of the initial state, or of the Euler-Maruyama step.
@@ -103,10 +114,12 @@ KOKKOS_INLINE_FUNCTION Vec<Model::obs_dim> precision_times_dy(const ParticleStep
   return d.observation_precision * load<Model::obs_dim>(d.dy, member);
 }
 
-/// Moves one particle (x in, x out) with its draws (normals z, uniform u) and returns its new log-weight,
-/// normalized by the member's previous log-normalizer; -inf for a particle that left the finite numbers.
+/// Moves one particle (x in, x out) over [t, t + dt] with its draws (normals z, uniform u) and returns its new
+/// log-weight, normalized by the member's previous log-normalizer; -inf for a particle that left the finite
+/// numbers. `precision` is V^{-1} at t.
 template <bool Initialize, class Model, class MemSpace>
-KOKKOS_INLINE_FUNCTION double update_particle(const ParticleStepData<Model, MemSpace>& d,
+KOKKOS_INLINE_FUNCTION double update_particle(const ParticleStepData<Model, MemSpace>& d, double t,
+                                              const Mat<Model::obs_dim, Model::obs_dim>& precision,
                                               const Vec<particle_draw_dim<Model, Initialize>>& z, double u,
                                               double log_weight, double log_normalizer,
                                               const Vec<Model::obs_dim>& vinv_dy, Vec<Model::state_dim>& x) {
@@ -116,13 +129,13 @@ KOKKOS_INLINE_FUNCTION double update_particle(const ParticleStepData<Model, MemS
     return 0.0;
   } else {
     if constexpr (has_exact_transition<Model>::value) {
-      x = d.model.sample_exact_transition(d.t, x, d.dt, z, u);
+      x = d.model.sample_exact_transition(t, x, d.dt, z, u);
     } else {
       const typename Model::Control control = Model::Control::zero();
-      x = x + d.model.drift(d.t, x, control) * d.dt + d.model.diffusion(d.t, x) * (z * d.sqrt_dt);
+      x = x + d.model.drift(t, x, control) * d.dt + d.model.diffusion(t, x) * (z * d.sqrt_dt);
     }
-    const Vec<p> h = d.model.observation(d.t + d.dt, x);
-    const double increment = dot(h, vinv_dy) - 0.5 * d.dt * dot(h, d.observation_precision * h);
+    const Vec<p> h = d.model.observation(t + d.dt, x);
+    const double increment = dot(h, vinv_dy) - 0.5 * d.dt * dot(h, precision * h);
     const double l = log_weight - log_normalizer + increment;
     bool finite = math::is_finite(l);
     KUSHNER_UNROLL_FULLY
@@ -179,7 +192,8 @@ KUSHNER_SIMD
     KUSHNER_UNROLL_FULLY
     for (int i = 0; i < K; ++i) zj[i] = z[i][j];
     const double uj = draws_uniform<Model, Initialize> ? u[j] : 0.0;
-    const double lj = update_particle<Initialize>(d, zj, uj, lw[j], log_normalizer, vinv_dy, xj);
+    const double lj =
+        update_particle<Initialize>(d, d.t, d.observation_precision, zj, uj, lw[j], log_normalizer, vinv_dy, xj);
     KUSHNER_UNROLL_FULLY
     for (int i = 0; i < n; ++i) xs[i][j] = xj[i];
     lw[j] = lj;
@@ -239,13 +253,12 @@ struct ParticleBlockStep {
   }
 };
 
-/// The largest log-likelihood increment any particle of `member` can get this step: h.a - (dt/2) h^T V^-1 h
+/// The largest log-likelihood increment any particle can get from an increment dy: h.a - (dt/2) h^T V^-1 h
 /// with a = V^-1 dy is largest at h = V a / dt, where it is dy^T V^-1 dy / (2 dt). The previous log-weights
 /// are normalized (each <= 0), so this bounds every new log-weight from above; 0 where it is not finite.
-template <class Model, class MemSpace>
-KOKKOS_INLINE_FUNCTION double log_weight_bound(const ParticleStepData<Model, MemSpace>& d, int member,
-                                               const Vec<Model::obs_dim>& vinv_dy) {
-  const double bound = 0.5 * dot(load<Model::obs_dim>(d.dy, member), vinv_dy) / d.dt;
+template <int P>
+KOKKOS_INLINE_FUNCTION double log_weight_bound(const Vec<P>& dy, const Vec<P>& vinv_dy, double dt) {
+  const double bound = 0.5 * dot(dy, vinv_dy) / dt;
   return math::is_finite(bound) ? bound : 0.0;
 }
 
@@ -262,10 +275,21 @@ KOKKOS_INLINE_FUNCTION double log_weight_bound(const ParticleStepData<Model, Mem
 /// get): no running maximum, one exp per particle, and the team's sums add without rescaling (warp shuffles,
 /// then the warps in order). Where the team's largest l is more than `max_shift_gap` from s (particles far
 /// from the observation, an extreme dy), the sums could under- or overflow: the team then sums its particles
-/// again, from the values it just stored, with s = its largest l. Every sum has an order fixed by the team
-/// size, so a seed gives the same bits on every run.
-template <class Model, class ExecSpace, int P = device_particle_batch>
+/// again with s = its largest l. Every sum has an order fixed by the team size, so a seed gives the same bits
+/// on every run.
+///
+/// Steps = 2 fuses two steps (k and k + 1) into one pass: the particles stay in registers between them, so a
+/// particle-step moves half the bytes (on an H100 the step runs at its power limit, and memory traffic is a
+/// large part of that power). The log-weights of step k + 1 are left normalized by step k - 1's normalizer
+/// (step k's is not known yet), its shift is the sum of both steps' bounds, and both steps' moments are taken
+/// relative to the same reference point. ParticleFilterBank::step_pair redoes the members that step k
+/// resamples.
+///
+/// Listed: a fixed league loops over the (listed member, chunk) items of d.members instead (a separate
+/// instantiation: the loop costs the 64-register kernel registers).
+template <class Model, class ExecSpace, int P = device_particle_batch, int Steps = 1, bool Listed = false>
 struct ParticleTeamStep {
+  static_assert(Steps == 1 || Steps == 2, "ParticleTeamStep: one step or a fused pair");
   using MemSpace = typename ExecSpace::memory_space;
   using Team = typename Kokkos::TeamPolicy<ExecSpace>::member_type;
   using Scratch = Kokkos::View<double*, typename ExecSpace::scratch_memory_space, Kokkos::MemoryUnmanaged>;
@@ -278,40 +302,77 @@ struct ParticleTeamStep {
   static std::size_t scratch_bytes(int team_size) { return sizeof(double) * values * (team_size + 1); }
 
   KOKKOS_INLINE_FUNCTION void operator()(const Team& team) const {
-    const int member = team.league_rank() / chunks_per_member, chunk = team.league_rank() % chunks_per_member;
+    if constexpr (Listed) {
+      const int items = d.member_count() * chunks_per_member;
+      for (int item = team.league_rank(); item < items; item += team.league_size())
+        step_chunk(team, d.members(item / chunks_per_member), item % chunks_per_member);
+    } else {
+      step_chunk(team, team.league_rank() / chunks_per_member, team.league_rank() % chunks_per_member);
+    }
+  }
+
+ private:
+  KOKKOS_INLINE_FUNCTION void step_chunk(const Team& team, int member, int chunk) const {
     const int threads = team.team_size(), rank = team.team_rank();
     const Scratch buffer(team.team_scratch(0), values * (threads + 1));
     const int begin = chunk * d.block_size;
     const int end = begin + d.block_size < d.num_particles ? begin + d.block_size : d.num_particles;
-    WeightedMoments<n> w = WeightedMoments<n>::empty();  // sums relative to `shift`; max_log_weight: largest l
-    double shift = 0.0;
+    WeightedMoments<n> w[Steps];  // sums relative to `shift`; max_log_weight: largest l
+    double shift[Steps];
+    Vec<p> vinv_dy[Steps];
+    KUSHNER_DEVICE_UNROLL
+    for (int s = 0; s < Steps; ++s) {
+      w[s] = WeightedMoments<n>::empty();
+      shift[s] = 0.0;
+      vinv_dy[s] = Vec<p>::zero();
+    }
     Vec<n> ref = Vec<n>::zero();
     if (d.status(member) == Status::ok) {
       ref = load<n>(d.reference, member);
-      if (d.initialize) {
-        step_particles<true>(member, begin, end, rank, threads, ref, shift, w);
+      if (Steps == 1 && d.initialize) {
+        if constexpr (Steps == 1) step_particles<true>(member, begin, end, rank, threads, ref, vinv_dy, shift, w);
       } else {
-        const Vec<p> vinv_dy = precision_times_dy(d, member);
-        shift = log_weight_bound(d, member, vinv_dy);
-        step_particles<false>(member, begin, end, rank, threads, ref, shift, w);
+        double bound = 0.0;
+        KUSHNER_DEVICE_UNROLL
+        for (int s = 0; s < Steps; ++s) {
+          const Vec<p> dy = load<p>(s == 0 ? d.dy : d.dy_next, member);
+          vinv_dy[s] = precision(s) * dy;
+          bound += log_weight_bound(dy, vinv_dy[s], d.dt);
+          shift[s] = bound;
+        }
+        step_particles<false>(member, begin, end, rank, threads, ref, vinv_dy, shift, w);
       }
     }
-    team_sum(team, buffer, w);
-    if (w.max_log_weight > -positive_infinity()) {
-      const double gap = w.max_log_weight - shift;
-      if (!(gap >= -max_shift_gap && gap <= max_shift_gap)) {  // rare: the same for the whole team
-        shift = w.max_log_weight;
-        w = WeightedMoments<n>::empty();
-        for (int j = begin + rank; j < end; j += threads) add_particle(d.log_weight(j, member) - shift,
-                                                                       load_particle<n>(d.x, j, member) - ref, w);
-        team_sum(team, buffer, w);
-      }
-      w.max_log_weight = shift;
-    }  // else every particle of the chunk has weight zero: w is empty
-    if (rank == 0) w.store(d.partials, chunk, member);
+    KUSHNER_DEVICE_UNROLL
+    for (int s = 0; s < Steps; ++s) {
+      team_sum(team, buffer, w[s]);
+      if (w[s].max_log_weight > -positive_infinity()) {
+        const double gap = w[s].max_log_weight - shift[s];
+        if (!(gap >= -max_shift_gap && gap <= max_shift_gap)) {  // rare: the same for the whole team
+          shift[s] = w[s].max_log_weight;
+          w[s] = WeightedMoments<n>::empty();
+          if (s == Steps - 1) {  // from the values just stored
+            const auto& x = Steps == 1 ? d.x : d.x_out;
+            const auto& lw = Steps == 1 ? d.log_weight : d.log_weight_out;
+            for (int j = begin + rank; j < end; j += threads)
+              add_particle(lw(j, member) - shift[s], load_particle<n>(x, j, member) - ref, w[s]);
+          } else {  // the first step of a pair, recomputed from its inputs
+            resum_first_step(member, begin, end, rank, threads, ref, vinv_dy[0], shift[0], w[0]);
+          }
+          team_sum(team, buffer, w[s]);
+        }
+        w[s].max_log_weight = shift[s];
+      }  // else every particle of the chunk has weight zero: w is empty
+      if (rank == 0) w[s].store(s == 0 ? d.partials : d.partials_next, chunk, member);
+    }
   }
 
- private:
+  /// Step s of the pass: its start time and V^{-1} there.
+  KOKKOS_INLINE_FUNCTION double step_time(int s) const { return s == 0 ? d.t : d.t_next; }
+  KOKKOS_INLINE_FUNCTION const Mat<p, p>& precision(int s) const {
+    return s == 0 ? d.observation_precision : d.observation_precision_next;
+  }
+
   /// Adds a particle of log-weight l - shift (the largest l goes to max_log_weight); weight zero adds nothing
   /// (its x may not be finite).
   KOKKOS_INLINE_FUNCTION static void add_particle(double shifted, const Vec<n>& dx, WeightedMoments<n>& w) {
@@ -319,20 +380,40 @@ struct ParticleTeamStep {
     if (e > 0.0) w.add_weight(e, dx);
   }
 
+  /// The draws of particles 2 pair (z0, u0) and 2 pair + 1 (z1, u1) at `step`.
+  template <bool Initialize>
+  KOKKOS_INLINE_FUNCTION static void draw_pair(const RngKey& key, int member, int pair, std::uint32_t step,
+                                               Vec<particle_draw_dim<Model, Initialize>>& z0,
+                                               Vec<particle_draw_dim<Model, Initialize>>& z1, double& u0, double& u1) {
+    constexpr int K = particle_draw_dim<Model, Initialize>;
+    KUSHNER_DEVICE_UNROLL
+    for (int i = 0; i < K; ++i) {
+      const NormalPair zi = pair_normals<Random123Draws>(key, member, pair, step, i);
+      z0[i] = zi.z0;
+      z1[i] = zi.z1;
+    }
+    u0 = u1 = 0.0;
+    if constexpr (draws_uniform<Model, Initialize>) pair_uniforms<Random123Draws>(key, member, pair, step, K, u0, u1);
+  }
+
   /// The particles [begin, end) of `member`, pairs (2 k, 2 k + 1) sharing their draws: thread `rank` takes
   /// pairs begin / 2 + rank, + threads, ..., B at a time. A batch's loads are issued first and its draws
   /// computed next (they need no memory), so the draws run while the loads are in flight.
   template <bool Initialize>
   KOKKOS_INLINE_FUNCTION void step_particles(int member, int begin, int end, int rank, int threads, const Vec<n>& ref,
-                                             double shift, WeightedMoments<n>& w) const {
+                                             const Vec<p>* vinv_dy, const double* shift,
+                                             WeightedMoments<n>* w) const {
     constexpr int B = (P + 1) / 2;  // pairs per batch
     constexpr int K = particle_draw_dim<Model, Initialize>;
     const double log_normalizer = Initialize ? 0.0 : d.log_normalizer(member);
-    const Vec<p> vinv_dy = Initialize ? Vec<p>::zero() : precision_times_dy(d, member);
-    double top = -positive_infinity();
+    double top[Steps];
+    KUSHNER_DEVICE_UNROLL
+    for (int s = 0; s < Steps; ++s) top[s] = -positive_infinity();
     // The member's columns as pointers: one 64-bit address computation per thread, not per access.
     double* const xm = &d.x(0, member, 0);
     double* const lwm = &d.log_weight(0, member);
+    double* const xo = Steps == 1 ? xm : &d.x_out(0, member, 0);
+    double* const lwo = Steps == 1 ? lwm : &d.log_weight_out(0, member);
     const std::size_t x_stride = d.x.stride_2();  // LayoutLeft: x(j, member, i) = xm[j + i * x_stride]
     const int end_pair = (end + 1) / 2;
     const RngKey key = particle_draw_key<Initialize>(d);
@@ -349,34 +430,55 @@ struct ParticleTeamStep {
           lw[k] = Initialize ? 0.0 : lwm[j];
         }
       }
-      Vec<K> z[2 * B];
-      double u[2 * B];
       KUSHNER_DEVICE_UNROLL
-      for (int b = 0; b < B; ++b) {
-        const int pair = base + b * threads;
+      for (int s = 0; s < Steps; ++s) {
+        Vec<K> z[2 * B];
+        double u[2 * B];
         KUSHNER_DEVICE_UNROLL
-        for (int i = 0; i < K; ++i) {
-          const NormalPair zi = pair_normals<Random123Draws>(key, member, pair, step, i);
-          z[2 * b][i] = zi.z0;
-          z[2 * b + 1][i] = zi.z1;
+        for (int b = 0; b < B; ++b)
+          draw_pair<Initialize>(key, member, base + b * threads, step + s, z[2 * b], z[2 * b + 1], u[2 * b],
+                                u[2 * b + 1]);
+        KUSHNER_DEVICE_UNROLL
+        for (int k = 0; k < 2 * B; ++k) {
+          const int j = 2 * (base + (k / 2) * threads) + k % 2;
+          if (j >= end) continue;
+          const double l = update_particle<Initialize>(d, step_time(s), precision(s), z[k], u[k], lw[k],
+                                                       s == 0 ? log_normalizer : 0.0, vinv_dy[s], x[k]);
+          if (s == Steps - 1) {
+            KUSHNER_DEVICE_UNROLL
+            for (int i = 0; i < n; ++i) xo[j + i * x_stride] = x[k][i];
+            lwo[j] = l;
+          }
+          lw[k] = l;
+          top[s] = l > top[s] ? l : top[s];
+          add_particle(l - shift[s], x[k] - ref, w[s]);
         }
-        u[2 * b] = u[2 * b + 1] = 0.0;
-        if constexpr (draws_uniform<Model, Initialize>)
-          pair_uniforms<Random123Draws>(key, member, pair, step, K, u[2 * b], u[2 * b + 1]);
-      }
-      KUSHNER_DEVICE_UNROLL
-      for (int k = 0; k < 2 * B; ++k) {
-        const int j = 2 * (base + (k / 2) * threads) + k % 2;
-        if (j >= end) continue;
-        const double l = update_particle<Initialize>(d, z[k], u[k], lw[k], log_normalizer, vinv_dy, x[k]);
-        KUSHNER_DEVICE_UNROLL
-        for (int i = 0; i < n; ++i) xm[j + i * x_stride] = x[k][i];
-        lwm[j] = l;
-        top = l > top ? l : top;
-        add_particle(l - shift, x[k] - ref, w);
       }
     }
-    w.max_log_weight = top;
+    KUSHNER_DEVICE_UNROLL
+    for (int s = 0; s < Steps; ++s) w[s].max_log_weight = top[s];
+  }
+
+  /// The first step of a pair again, from the pass's inputs (which it did not overwrite), summed with `shift`.
+  KOKKOS_INLINE_FUNCTION void resum_first_step(int member, int begin, int end, int rank, int threads,
+                                               const Vec<n>& ref, const Vec<p>& vinv_dy, double shift,
+                                               WeightedMoments<n>& w) const {
+    constexpr int K = particle_draw_dim<Model, false>;
+    const double log_normalizer = d.log_normalizer(member);
+    const RngKey key = particle_draw_key<false>(d);
+    for (int pair = begin / 2 + rank; pair < (end + 1) / 2; pair += threads) {
+      Vec<K> z[2];
+      double u[2];
+      draw_pair<false>(key, member, pair, d.step, z[0], z[1], u[0], u[1]);
+      for (int k = 0; k < 2; ++k) {
+        const int j = 2 * pair + k;
+        if (j >= end) continue;
+        Vec<n> x = load_particle<n>(d.x, j, member);
+        const double l = update_particle<false>(d, d.t, d.observation_precision, z[k], u[k], d.log_weight(j, member),
+                                                log_normalizer, vinv_dy, x);
+        add_particle(l - shift, x - ref, w);
+      }
+    }
   }
 
   /// w <- the team's total (max for max_log_weight, sums for the rest) on every thread, in an order fixed by
