@@ -132,9 +132,7 @@ class ParticleFilterBank {
 
   /// Step k: [k dt, (k + 1) dt] with the members' observation increments dy (member, j) over it.
   void step(long k, double dt, const BankVector<MemSpace>& dy) {
-    KUSHNER_REQUIRE(dy.extent_int(0) == num_members_ && dy.extent_int(1) == Model::obs_dim,
-                    "dy has shape (" << dy.extent(0) << ", " << dy.extent(1) << "), expected (" << num_members_
-                                     << ", " << Model::obs_dim << ")");
+    require_increments_shape(dy);
     KUSHNER_REQUIRE(k >= 0 && k < (1L << 32), "step " << k << " outside the counter range");
     run_step_kernels(step_data(k * dt, dt, static_cast<std::uint32_t>(k), dy));
   }
@@ -157,10 +155,8 @@ class ParticleFilterBank {
       step(k + 1, dt, dy_next);
       return;
     }
-    for (const auto* v : {&dy, &dy_next})
-      KUSHNER_REQUIRE(v->extent_int(0) == num_members_ && v->extent_int(1) == Model::obs_dim,
-                      "dy has shape (" << v->extent(0) << ", " << v->extent(1) << "), expected (" << num_members_
-                                       << ", " << Model::obs_dim << ")");
+    require_increments_shape(dy);
+    require_increments_shape(dy_next);
     if (x_next_.extent(0) == 0) {
       x_next_ = ParticleBank<MemSpace>("kushner::particles_next", num_particles_, num_members_, state_dim);
       log_weight_next_ = decltype(log_weight_next_)("kushner::log_weights_next", num_particles_, num_members_);
@@ -188,14 +184,9 @@ class ParticleFilterBank {
     copy_listed_members<state_dim>(space_, CopyListedMembers<state_dim, MemSpace>{
         x_next_, x_, log_weight_next_, workspace_.cumulative, resample_list_, resample_list_size_, num_particles_,
         copy_items < listed_work_items ? copy_items : listed_work_items});
-    ParticleStepData<Model, MemSpace> redo = step_data(k * dt, dt, first, dy);
-    redo.members = resample_list_;
-    redo.member_count = resample_list_size_;
-    run_team_kernel<device_particle_batch, 1, true>(redo);
+    run_team_kernel<device_particle_batch, 1, true>(listed(step_data(k * dt, dt, first, dy)));
     resample_listed(first_log_normalizer_, first);
-    redo = step_data((k + 1) * dt, dt, second, dy_next);
-    redo.members = resample_list_;
-    redo.member_count = resample_list_size_;
+    ParticleStepData<Model, MemSpace> redo = listed(step_data((k + 1) * dt, dt, second, dy_next));
     redo.log_normalizer = first_log_normalizer_;  // log N after the resampling
     redo.partials = partials_next_;
     run_team_kernel<device_particle_batch, 1, true>(redo);
@@ -246,6 +237,19 @@ class ParticleFilterBank {
   const BankScalar<double, MemSpace>& log_normalizer() const { return log_normalizer_; }
 
  private:
+  void require_increments_shape(const BankVector<MemSpace>& dy) const {
+    KUSHNER_REQUIRE(dy.extent_int(0) == num_members_ && dy.extent_int(1) == Model::obs_dim,
+                    "dy has shape (" << dy.extent(0) << ", " << dy.extent(1) << "), expected (" << num_members_
+                                     << ", " << Model::obs_dim << ")");
+  }
+
+  /// d for the members on the resampling list only.
+  ParticleStepData<Model, MemSpace> listed(ParticleStepData<Model, MemSpace> d) const {
+    d.members = resample_list_;
+    d.member_count = resample_list_size_;
+    return d;
+  }
+
   /// (R R^T)^{-1} at t.
   Mat<Model::obs_dim, Model::obs_dim> observation_precision(double t) const {
     constexpr int p = Model::obs_dim;
