@@ -1,6 +1,6 @@
 #include "drivers/config_file.hpp"
 
-#include "kernels/errors.hpp"
+#include "core/errors.hpp"
 
 #include <filesystem>
 

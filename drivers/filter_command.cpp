@@ -1,7 +1,7 @@
 #include "drivers/filter_command.hpp"
-#include "drivers/backend.hpp"
+#include "engine/backend.hpp"
 #include "drivers/commands.hpp"
-#include "models/registry.hpp"
+#include "drivers/run_model.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -39,17 +39,17 @@ void print_summary(const nlohmann::json& summary, const std::string& out) {
 int run_estimation(const CompareOptions& options, const RunContext& context, const char* command) {
   validate_run_options(options.run);
   const TimeGrid grid = make_time_grid(options.run.T, options.run.dt, options.run.output_points);
-  const FilterConfig config = filter_config(options);
+  const OptionValues settings = filter_option_values(options);
   with_run_model(options.run.model, options.run.model_file, options.run.sets, [&](const auto& model) {
     using Model = std::decay_t<decltype(model)>;
     if constexpr (Model::discrete_time) {
       throw InputError(std::string("--model: '") + Model::name + "' is a discrete-time model; `kushner " + command +
                        "` runs the continuous-time filters");
     } else {
-      check_compare_options<Model>(model, options, config);  // before anything is written
+      check_compare_options<Model>(model, options, settings);  // before anything is written
       const OutputDirectory out(options.run.out, "--out");
       KokkosSession kokkos;
-      const nlohmann::json summary = run_compare_command(model, options, config, grid, context, out);
+      const nlohmann::json summary = run_compare_command(model, options, settings, grid, context, out);
       if (options.plots && !options.run.quiet) print_summary(summary, options.run.out);
     }
   });

@@ -19,13 +19,13 @@ namespace kushner {
 /// order. Call before opening the output directory, so that a refused run writes nothing.
 template <class Model>
 std::vector<std::string> check_compare_options(const Model& model, const CompareOptions& options,
-                                               const FilterConfig& config);
+                                               const OptionValues& settings);
 
 /// Runs truths, filters, particle filter and exact filter as `options` asks, writes into `out` summary.json,
 /// timeseries.csv and, as asked, trajectories.csv, density.csv, the plots and report.md; returns the summary.
 /// Needs Kokkos initialized (KokkosSession).
 template <class Model>
-nlohmann::json run_compare_command(const Model& model, const CompareOptions& options, const FilterConfig& config,
+nlohmann::json run_compare_command(const Model& model, const CompareOptions& options, const OptionValues& settings,
                                    const TimeGrid& grid, const RunContext& context, const OutputDirectory& out);
 
 }  // namespace kushner

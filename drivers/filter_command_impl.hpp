@@ -3,16 +3,18 @@
 // filter_command_*.cpp files): select and check the filters, run the bank with the particle and exact
 // references beside it, write summary.json and timeseries.csv, and for compare the chosen members'
 // trajectories, the density snapshots, the plots and report.md.
-#include "drivers/backend.hpp"
+#include "engine/backend.hpp"
 #include "drivers/csv.hpp"
+#include "drivers/fields_json.hpp"
 #include "drivers/filter_command.hpp"
-#include "drivers/filter_run.hpp"
+#include "engine/filter_run.hpp"
 #include "drivers/filter_selection.hpp"
 #include "drivers/output_directory.hpp"
 #include "drivers/plots.hpp"
+#include "drivers/progress.hpp"
 #include "drivers/trajectory_recorder.hpp"
 #include "models/parameters.hpp"
-#include "models/registry.hpp"
+#include "drivers/run_model.hpp"
 
 #include <algorithm>
 #include <functional>
@@ -37,8 +39,7 @@ inline std::string filter_timeseries_csv(const FilterReport& report, const RunCo
   return csv;
 }
 
-template <class Model>
-nlohmann::json filter_summary(const FilterReport& report, const FilterConfig& config) {
+inline nlohmann::json filter_summary(const FilterReport& report) {
   nlohmann::json filters = nlohmann::json::object();
   for (std::size_t f = 0; f < report.filters.size(); ++f) {
     const FilterScores& s = report.scores[f];
@@ -55,20 +56,10 @@ nlohmann::json filter_summary(const FilterReport& report, const FilterConfig& co
       j["rmse_ref"] = s.rmse_ref.value;
       j["rmse_ref_se"] = s.rmse_ref.standard_error;
     }
-    if (report.estimators.contains(report.filters[f])) j["estimator"] = report.estimators[report.filters[f]];
-    if (report.filters[f] == "QLF") {
-      const Expectations e = resolve_qlf_expectations<Model>(config.qlf_expectations);
-      j["expectations"] = e == Expectations::closed ? "closed" : "cubature";
-      if (e == Expectations::cubature) j["gh_nodes"] = config.gh_nodes;
-    }
-    if (report.filters[f] == "ASRE")
-      j["iterations"] = {{"mean", report.asre.mean},
-                         {"min", report.asre.min},
-                         {"max", report.asre.max},
-                         {"not_converged", report.asre.not_converged},
-                         {"diverged", report.asre.diverged},
-                         {"tolerance", config.asre_tolerance},
-                         {"max_iterations", config.asre_max_iterations}};
+    const auto estimator = report.estimators.find(report.filters[f]);
+    if (estimator != report.estimators.end()) j["estimator"] = fields_json(estimator->second);
+    const auto own = report.filter_fields.find(report.filters[f]);
+    if (own != report.filter_fields.end()) add_fields(j, own->second);
     filters[report.filters[f]] = j;
   }
   return filters;
@@ -78,16 +69,16 @@ nlohmann::json filter_summary(const FilterReport& report, const FilterConfig& co
 
 template <class Model>
 std::vector<std::string> check_compare_options(const Model& model, const CompareOptions& options,
-                                               const FilterConfig& config) {
+                                               const OptionValues& settings) {
   const std::vector<std::string> filters = select_estimators<Model>(options.filters, model);
+  const std::optional<OptionProblem> problem = filter_option_problem<Model>(filters, settings);
+  KUSHNER_INPUT_REQUIRE(!problem, option_flag(problem->option) << ": " << problem->message);
   if constexpr (has_exact_reference<Model>) {
     using Grid = GridFilter<Kokkos::DefaultHostExecutionSpace, Model>;
     if (std::is_same_v<exact_reference_t<Kokkos::DefaultHostExecutionSpace, Model>, Grid> &&
-        std::find(filters.begin(), filters.end(), "EXACT") != filters.end())
+        std::find(filters.begin(), filters.end(), exact_filter_name) != filters.end())
       check_covariance("filter EXACT (grid filter): prior_cov", model.prior_cov, /*allow_singular=*/false);
   }
-  if (std::find(filters.begin(), filters.end(), "QLF") != filters.end())
-    resolve_qlf_expectations<Model>(config.qlf_expectations);
   particle_settings(options);
   for (long m : options.trajectory_members)
     KUSHNER_INPUT_REQUIRE(m >= 0 && m < options.run.members,
@@ -122,9 +113,9 @@ struct NoExtraEstimators {
 /// model under "truth".
 template <class Model, class TruthModel, class MakeExtras = NoExtraEstimators>
 nlohmann::json run_compare_with_truth(const TruthModel& truth_model, const Model& model, const CompareOptions& options,
-                                      const FilterConfig& config, const TimeGrid& grid, const RunContext& context,
+                                      const OptionValues& settings, const TimeGrid& grid, const RunContext& context,
                                       const OutputDirectory& out, const MakeExtras& make_extras = {}) {
-  const std::vector<std::string> filters = check_compare_options<Model>(model, options, config);
+  const std::vector<std::string> filters = check_compare_options<Model>(model, options, settings);
   const ParticleSettings particle = particle_settings(options);
   std::vector<double> density_times = options.density_times;
   if (density_times.empty() && options.plots) density_times = {0.1 * options.run.T, 0.5 * options.run.T, options.run.T};
@@ -132,13 +123,13 @@ nlohmann::json run_compare_with_truth(const TruthModel& truth_model, const Model
   with_backend(context.backend, [&](const auto& space) {
     using ExecSpace = std::decay_t<decltype(space)>;
     TrajectoryRecorder<ExecSpace, Model> recorder(options.trajectory_members, options.run.members, density_times);
-    const bool asre = std::find(filters.begin(), filters.end(), "ASRE") != filters.end();
-    Progress progress(options.plots ? "compare" : "filter", grid.steps * (asre ? 3 : 1), !options.run.quiet);
+    Progress progress(options.plots ? "compare" : "filter", progress_steps<Model>(filters, grid), !options.run.quiet);
     OutputObserver<ExecSpace, Model, TruthModel> observer;
     if (!options.trajectory_members.empty()) observer = std::ref(recorder);
     const FilterReport report =
         run_filters(space, truth_model, model, options.run.members, static_cast<std::uint32_t>(options.run.seed), grid,
-                    filters, config, particle, &progress, observer, make_extras(space));
+                    filters, settings, particle, [&](long done) { progress.update(done); }, observer,
+                    make_extras(space));
     summary = run_metadata(context);
     summary["model"] = model_summary(model);
     if constexpr (!std::is_same_v<TruthModel, Model>)
@@ -151,11 +142,11 @@ nlohmann::json run_compare_with_truth(const TruthModel& truth_model, const Model
     summary["T"] = options.run.T;
     summary["dt"] = options.run.dt;
     summary["steps"] = grid.steps;
-    summary["filters"] = detail::filter_summary<Model>(report, config);
+    summary["filters"] = detail::filter_summary(report);
     summary["filter_order"] = report.filters;
     summary["truths_escaped"] = report.truths_escaped;
     if (report.has_reference) {
-      summary["reference"] = report.estimators[report.reference];
+      summary["reference"] = fields_json(report.estimators.at(report.reference));
       summary["reference"]["name"] = report.reference;
     }
     std::vector<std::string> files = {"summary.json", "timeseries.csv"};
@@ -176,9 +167,9 @@ nlohmann::json run_compare_with_truth(const TruthModel& truth_model, const Model
 }
 
 template <class Model>
-nlohmann::json run_compare_command(const Model& model, const CompareOptions& options, const FilterConfig& config,
+nlohmann::json run_compare_command(const Model& model, const CompareOptions& options, const OptionValues& settings,
                                    const TimeGrid& grid, const RunContext& context, const OutputDirectory& out) {
-  return run_compare_with_truth(model, model, options, config, grid, context, out);
+  return run_compare_with_truth(model, model, options, settings, grid, context, out);
 }
 
 }  // namespace kushner

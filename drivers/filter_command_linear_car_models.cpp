@@ -5,24 +5,24 @@
 namespace kushner {
 
 template std::vector<std::string> check_compare_options<LinearModel<1>>(const LinearModel<1>&, const CompareOptions&,
-                                                                    const FilterConfig&);
-template nlohmann::json run_compare_command<LinearModel<1>>(const LinearModel<1>&, const CompareOptions&, const FilterConfig&,
+                                                                    const OptionValues&);
+template nlohmann::json run_compare_command<LinearModel<1>>(const LinearModel<1>&, const CompareOptions&, const OptionValues&,
                                                   const TimeGrid&, const RunContext&, const OutputDirectory&);
 template std::vector<std::string> check_compare_options<LinearModel<2>>(const LinearModel<2>&, const CompareOptions&,
-                                                                    const FilterConfig&);
-template nlohmann::json run_compare_command<LinearModel<2>>(const LinearModel<2>&, const CompareOptions&, const FilterConfig&,
+                                                                    const OptionValues&);
+template nlohmann::json run_compare_command<LinearModel<2>>(const LinearModel<2>&, const CompareOptions&, const OptionValues&,
                                                   const TimeGrid&, const RunContext&, const OutputDirectory&);
 template std::vector<std::string> check_compare_options<LinearModel<3>>(const LinearModel<3>&, const CompareOptions&,
-                                                                    const FilterConfig&);
-template nlohmann::json run_compare_command<LinearModel<3>>(const LinearModel<3>&, const CompareOptions&, const FilterConfig&,
+                                                                    const OptionValues&);
+template nlohmann::json run_compare_command<LinearModel<3>>(const LinearModel<3>&, const CompareOptions&, const OptionValues&,
                                                   const TimeGrid&, const RunContext&, const OutputDirectory&);
 template std::vector<std::string> check_compare_options<CarModel>(const CarModel&, const CompareOptions&,
-                                                                    const FilterConfig&);
-template nlohmann::json run_compare_command<CarModel>(const CarModel&, const CompareOptions&, const FilterConfig&,
+                                                                    const OptionValues&);
+template nlohmann::json run_compare_command<CarModel>(const CarModel&, const CompareOptions&, const OptionValues&,
                                                   const TimeGrid&, const RunContext&, const OutputDirectory&);
 template std::vector<std::string> check_compare_options<CarTaylor3Model>(const CarTaylor3Model&, const CompareOptions&,
-                                                                    const FilterConfig&);
-template nlohmann::json run_compare_command<CarTaylor3Model>(const CarTaylor3Model&, const CompareOptions&, const FilterConfig&,
+                                                                    const OptionValues&);
+template nlohmann::json run_compare_command<CarTaylor3Model>(const CarTaylor3Model&, const CompareOptions&, const OptionValues&,
                                                   const TimeGrid&, const RunContext&, const OutputDirectory&);
 
 }  // namespace kushner

@@ -5,8 +5,8 @@
 namespace kushner {
 
 template std::vector<std::string> check_compare_options<TerpolymerModel>(const TerpolymerModel&, const CompareOptions&,
-                                                                    const FilterConfig&);
-template nlohmann::json run_compare_command<TerpolymerModel>(const TerpolymerModel&, const CompareOptions&, const FilterConfig&,
+                                                                    const OptionValues&);
+template nlohmann::json run_compare_command<TerpolymerModel>(const TerpolymerModel&, const CompareOptions&, const OptionValues&,
                                                   const TimeGrid&, const RunContext&, const OutputDirectory&);
 
 }  // namespace kushner

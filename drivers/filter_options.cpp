@@ -1,24 +1,56 @@
 #include "drivers/filter_options.hpp"
-#include "kernels/errors.hpp"
 
+#include "core/errors.hpp"
+#include "kernels/filters/filter_list.hpp"
+
+#include <algorithm>
 #include <cmath>
+#include <optional>
+#include <sstream>
+#include <variant>
 
 namespace kushner {
+
+namespace {
+
+std::string value_text(long v) { return std::to_string(v); }
+std::string value_text(double v) {
+  std::ostringstream text;
+  text << v;
+  return text.str();
+}
+std::string value_text(const std::string& v) { return v; }
+
+/// `text` as a value of an option of `kind`: the whole text must be the number.
+std::optional<Value> parse_value(const std::string& text, OptionSpec::Kind kind) {
+  if (kind == OptionSpec::Kind::choice) return Value(text);
+  std::size_t used = 0;
+  try {
+    if (kind == OptionSpec::Kind::integer) {
+      const long v = std::stol(text, &used);
+      if (used == text.size()) return Value(v);
+    } else {
+      const double v = std::stod(text, &used);
+      if (used == text.size()) return Value(v);
+    }
+  } catch (const std::exception&) {
+  }
+  return std::nullopt;
+}
+
+}  // namespace
 
 void add_filter_options(CLI::App& app, FilterOptions& o) {
   add_run_options(app, o.run);
   app.add_option("--filters", o.filters, "comma-separated filters, or all (see `kushner filters`)")
       ->capture_default_str();
-  app.add_option("--qlf-expectations", o.qlf_expectations,
-                 "QLF's Gaussian expectations: closed (the model's formulas), cubature (Gauss-Hermite), or auto "
-                 "(closed where the model has them)")
-      ->check(CLI::IsMember({"auto", "closed", "cubature"}))
-      ->capture_default_str();
-  app.add_option("--gh-nodes", o.gh_nodes, "Gauss-Hermite nodes per axis for QLF cubature")->capture_default_str();
-  app.add_option("--asre-tolerance", o.asre_tolerance,
-                 "ASRE stops iterating when max_t |m^[i](t) - m^[i-1](t)| is below this")
-      ->capture_default_str();
-  app.add_option("--asre-max-iterations", o.asre_max_iterations, "ASRE iterations at most")->capture_default_str();
+  for (const OptionSpec& spec : all_filter_options()) {
+    auto* option = app.add_option_function<std::string>(
+        option_flag(spec.name), [&o, name = spec.name](const std::string& v) { o.filter_settings[name] = v; },
+        spec.help);
+    option->default_str(std::visit([](const auto& v) { return value_text(v); }, spec.default_value));
+    if (spec.kind == OptionSpec::Kind::choice) option->check(CLI::IsMember(spec.choices));
+  }
   app.add_option("--particles", o.particles, "particles per member of the particle filter (PF)")
       ->capture_default_str();
   app.add_option("--resample", o.resample, "PF resampling scheme: systematic, stratified, multinomial, residual")
@@ -46,26 +78,40 @@ ParticleSettings particle_settings(const FilterOptions& o) {
                         "--ess-threshold: must be in [0, 1] (got " << o.ess_threshold << ")");
   ParticleSettings settings;
   settings.particles = o.particles;
-  settings.options.scheme = parse_resampling_scheme(o.resample);
+  const std::optional<ResamplingScheme> scheme = resampling_scheme_named(o.resample);
+  KUSHNER_INPUT_REQUIRE(scheme.has_value(), "--resample: unknown scheme '"
+                                                << o.resample << "' (known: multinomial, residual, stratified, systematic)");
+  settings.options.scheme = *scheme;
   settings.options.ess_threshold = o.ess_threshold;
   return settings;
 }
 
-FilterConfig filter_config(const FilterOptions& o) {
-  FilterConfig config;
-  config.qlf_expectations = o.qlf_expectations == "closed"     ? Expectations::closed
-                            : o.qlf_expectations == "cubature" ? Expectations::cubature
-                                                               : Expectations::automatic;
-  KUSHNER_INPUT_REQUIRE(o.gh_nodes >= 1 && o.gh_nodes <= max_gauss_hermite_nodes,
-                        "--gh-nodes: must be in 1 .. " << max_gauss_hermite_nodes << " (got " << o.gh_nodes << ")");
-  KUSHNER_INPUT_REQUIRE(std::isfinite(o.asre_tolerance) && o.asre_tolerance > 0.0,
-                        "--asre-tolerance: must be positive (got " << o.asre_tolerance << ")");
-  KUSHNER_INPUT_REQUIRE(o.asre_max_iterations >= 1 && o.asre_max_iterations <= 1000,
-                        "--asre-max-iterations: must be in 1 .. 1000 (got " << o.asre_max_iterations << ")");
-  config.gh_nodes = o.gh_nodes;
-  config.asre_tolerance = o.asre_tolerance;
-  config.asre_max_iterations = o.asre_max_iterations;
-  return config;
+std::string option_flag(const std::string& name) {
+  std::string flag = "--" + name;
+  std::replace(flag.begin(), flag.end(), '_', '-');
+  return flag;
+}
+
+OptionValues filter_option_values(const FilterOptions& o) {
+  OptionValues values;
+  for (const OptionSpec& spec : all_filter_options()) {
+    const auto given = o.filter_settings.find(spec.name);
+    if (given == o.filter_settings.end()) {
+      values.set(spec.name, spec.default_value);
+      continue;
+    }
+    const std::string& text = given->second;
+    const std::optional<Value> value = parse_value(text, spec.kind);
+    KUSHNER_INPUT_REQUIRE(value.has_value(), option_flag(spec.name) << ": expected "
+                                                 << (spec.kind == OptionSpec::Kind::integer ? "an integer" : "a number")
+                                                 << " (got '" << text << "')");
+    const std::string problem = option_value_problem(spec, *value);
+    KUSHNER_INPUT_REQUIRE(problem.empty(), option_flag(spec.name) << ": " << problem);
+    values.set(spec.name, *value);
+  }
+  for (const auto& given : o.filter_settings)
+    KUSHNER_REQUIRE(values.has(given.first), "no filter declares the option '" << given.first << "'");
+  return values;
 }
 
 }  // namespace kushner

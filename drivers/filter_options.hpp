@@ -1,12 +1,13 @@
 #pragma once
 // Options of `kushner filter` and `kushner compare`: the run options shared with `simulate`, which filters,
 // the settings of the filters that have any (the particle filter's among them), and what `compare` adds.
-#include "drivers/particle_reference.hpp"
+#include "core/options.hpp"
 #include "drivers/run_options.hpp"
-#include "kernels/filters/filter_config.hpp"
+#include "engine/particle_reference.hpp"
 
 #include <CLI/CLI.hpp>
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -15,10 +16,9 @@ namespace kushner {
 struct FilterOptions {
   RunOptions run;
   std::string filters = "all";
-  std::string qlf_expectations = "auto";
-  int gh_nodes = FilterConfig{}.gh_nodes;
-  double asre_tolerance = FilterConfig{}.asre_tolerance;
-  int asre_max_iterations = FilterConfig{}.asre_max_iterations;
+  /// The filters' own settings as given (option name -> text); each filter declares its options, and the
+  /// absent ones take the declared defaults (kernels/filters/filter_protocol.hpp).
+  std::map<std::string, std::string> filter_settings;
   int particles = ParticleSettings{}.particles;
   std::string resample = "systematic";
   double ess_threshold = ParticleFilterOptions{}.ess_threshold;
@@ -31,7 +31,7 @@ struct CompareOptions : FilterOptions {
   bool plots = true;                                 // plots and report.md (Python with matplotlib)
 };
 
-/// The run options plus --filters, --qlf-expectations, --gh-nodes, --asre-tolerance, --asre-max-iterations,
+/// The run options plus --filters, every filter's declared options (--gh-nodes, --asre-tolerance, ...),
 /// --particles, --resample, --ess-threshold.
 void add_filter_options(CLI::App& app, FilterOptions& options);
 
@@ -42,8 +42,12 @@ void add_compare_options(CLI::App& app, CompareOptions& options);
 /// outside [0, 1].
 ParticleSettings particle_settings(const FilterOptions& options);
 
-/// The filters' settings; InputError (one line naming the option) for values no run can use. What depends
-/// on the model (unsupported filters, closed forms) is checked by select_filters and the filters themselves.
-FilterConfig filter_config(const FilterOptions& options);
+/// The command-line spelling of an option declared as `name`: "gh_nodes" -> "--gh-nodes".
+std::string option_flag(const std::string& name);
+
+/// The filters' settings, every declared option given or defaulted; InputError (one line naming the option)
+/// for a value outside its declared range. What depends on the model (unsupported filters, closed forms) is
+/// checked by select_estimators and check_filter_settings.
+OptionValues filter_option_values(const FilterOptions& options);
 
 }  // namespace kushner

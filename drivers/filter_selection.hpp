@@ -1,11 +1,10 @@
 #pragma once
 // `--filters` on the command line: names to the filters a model supports, in report order, or one clear
 // InputError line ("filter POLY3 does not support model 'car' (drift is not polynomial)").
-#include "drivers/exact_reference_estimator.hpp"
-#include "drivers/particle_reference.hpp"
-#include "kernels/errors.hpp"
+#include "core/errors.hpp"
+#include "engine/exact_reference_estimator.hpp"
+#include "engine/particle_reference.hpp"
 #include "kernels/filters/filter_list.hpp"
-#include "models/linear_model.hpp"
 
 #include <algorithm>
 #include <string>
@@ -13,27 +12,13 @@
 
 namespace kushner {
 
-/// Every filter name, in report order.
-inline std::vector<std::string> all_filter_names() {
-  std::vector<std::string> names;
-  for (const auto& f : filter_support<LinearModel<1>>()) names.push_back(f.name);  // names do not depend on the model
-  return names;
-}
-
 /// "all", or a comma-separated list of names (case-sensitive), checked against what Model supports and, for a
 /// model with a run-time check (a --model-file polynomial), against what `model`'s coefficients allow.
 template <class Model>
 std::vector<std::string> select_filters(const std::string& list, const Model& model) {
-  const std::vector<FilterSupport> support = filter_support<Model>();
-  const auto unsupported = [&](const FilterSupport& f) {
-    return f.unsupported != nullptr ? f.unsupported : runtime_filter_unsupported(model, f.name.c_str());
-  };
+  if (list == "all") return supported_filters(model);
+  const std::vector<FilterSupport> support = filter_support(model);
   std::vector<std::string> requested;
-  if (list == "all") {
-    for (const auto& f : support)
-      if (unsupported(f) == nullptr) requested.push_back(f.name);
-    return requested;
-  }
   std::string current;
   for (std::size_t i = 0; i <= list.size(); ++i) {
     if (i == list.size() || list[i] == ',') {
@@ -50,22 +35,16 @@ std::vector<std::string> select_filters(const std::string& list, const Model& mo
     if (it == support.end()) {
       std::string known;
       for (const auto& f : support) known += (known.empty() ? "" : ", ") + f.name;
-      throw InputError("--filters: unknown filter '" + name + "' (known: " + known + ", PF, EXACT, or all)");
+      throw InputError("--filters: unknown filter '" + name + "' (known: " + known + ", " + particle_filter_name + ", " +
+                       exact_filter_name + ", or all)");
     }
-    KUSHNER_INPUT_REQUIRE(unsupported(*it) == nullptr, "filter " << name << " does not support model '" << Model::name
-                                                                 << "' (" << unsupported(*it) << ")");
+    KUSHNER_INPUT_REQUIRE(it->unsupported == nullptr, "filter " << name << " does not support model '" << Model::name
+                                                                << "' (" << it->unsupported << ")");
   }
   std::vector<std::string> ordered;  // report order, each once
   for (const auto& f : support)
     if (std::find(requested.begin(), requested.end(), f.name) != requested.end()) ordered.push_back(f.name);
   return ordered;
-}
-
-/// select_filters for a model whose support is known from its type alone.
-template <class Model>
-std::vector<std::string> select_filters(const std::string& list) {
-  static_assert(!ModelTraits<Model>::runtime_checked, "select_filters: pass the model, its coefficients decide");
-  return select_filters<Model>(list, Model{});
 }
 
 /// `--filters` with the estimators beside the bank: the bank's filters (select_filters), then "PF" (the
@@ -84,19 +63,16 @@ std::vector<std::string> select_estimators(const std::string& list, const Model&
     }
     if (current == "all") {
       all = true;
-    } else if (current == "PF") {
+    } else if (current == particle_filter_name) {
       KUSHNER_INPUT_REQUIRE(particle_filter_unsupported<Model>() == nullptr,
-                            "filter PF does not support model '" << Model::name << "' ("
-                                                                 << particle_filter_unsupported<Model>() << ")");
+                            "filter " << particle_filter_name << " does not support model '" << Model::name << "' ("
+                                      << particle_filter_unsupported<Model>() << ")");
       particle = true;
-    } else if (current == "EXACT") {
-      KUSHNER_INPUT_REQUIRE(has_exact_reference<Model>, "filter EXACT does not support model '"
-                                                            << Model::name
-                                                            << "' (no exact filter, and no grid filter above "
-                                                               "dimension 2 or for discrete time)");
-      const char* why_not = runtime_filter_unsupported(model, "EXACT");
+    } else if (current == exact_filter_name) {
+      const char* why_not = exact_filter_unsupported(model);
       KUSHNER_INPUT_REQUIRE(why_not == nullptr,
-                            "filter EXACT does not support model '" << Model::name << "' (" << why_not << ")");
+                            "filter " << exact_filter_name << " does not support model '" << Model::name << "' ("
+                                      << why_not << ")");
       exact = true;
     } else {
       bank_list += (bank_list.empty() ? "" : ",") + current;
@@ -110,8 +86,8 @@ std::vector<std::string> select_estimators(const std::string& list, const Model&
   }
   std::vector<std::string> names =
       bank_list.empty() ? std::vector<std::string>{} : select_filters<Model>(bank_list, model);
-  if (particle) names.push_back("PF");
-  if (exact) names.push_back("EXACT");
+  if (particle) names.push_back(particle_filter_name);
+  if (exact) names.push_back(exact_filter_name);
   return names;
 }
 

@@ -1,9 +1,12 @@
-#include "drivers/backend.hpp"
+#include "engine/backend.hpp"
 #include "drivers/commands.hpp"
+#include "drivers/filter_options.hpp"
 #include "drivers/filter_selection.hpp"
 #include "models/registry.hpp"
 
+#include <cmath>
 #include <iostream>
+#include <variant>
 #include <map>
 
 namespace kushner {
@@ -41,11 +44,22 @@ int run_filters_list(bool json) {
   const std::vector<std::string> names = all_filter_names();
   std::map<std::string, nlohmann::json> supported, refused;
   std::map<std::string, std::string> descriptions;
+  std::map<std::string, nlohmann::json> options;
   detail::for_each_model_type([&](auto* tag) {
     using Model = std::remove_pointer_t<decltype(tag)>;
     if constexpr (!Model::discrete_time && listed_once<Model>()) {
-      for (const auto& f : filter_support<Model>()) {
+      for (const auto& f : filter_support(Model{})) {
         descriptions[f.name] = f.description;
+        options[f.name] = nlohmann::json::array();
+        for (const OptionSpec& o : f.options) {
+          nlohmann::json option = {{"name", option_flag(o.name)}, {"help", o.help}};
+          std::visit([&](const auto& v) { option["default"] = v; }, o.default_value);
+          if (o.kind == OptionSpec::Kind::choice) option["choices"] = o.choices;
+          if (o.kind != OptionSpec::Kind::choice && std::isfinite(o.min)) option["min"] = o.min;
+          if (o.kind != OptionSpec::Kind::choice && std::isfinite(o.max)) option["max"] = o.max;
+          if (o.positive) option["positive"] = true;
+          options[f.name].push_back(option);
+        }
         if (f.unsupported == nullptr) supported[f.name].push_back(Model::name);
         else refused[f.name].push_back({{"model", Model::name}, {"reason", f.unsupported}});
       }
@@ -56,7 +70,11 @@ int run_filters_list(bool json) {
     nlohmann::json s = supported.count(name) ? supported[name] : nlohmann::json::array();
     nlohmann::json r = refused.count(name) ? refused[name] : nlohmann::json::array();
     std::sort(s.begin(), s.end());
-    list.push_back({{"name", name}, {"description", descriptions[name]}, {"models", s}, {"refuses", r}});
+    list.push_back({{"name", name},
+                    {"description", descriptions[name]},
+                    {"models", s},
+                    {"refuses", r},
+                    {"options", options[name]}});
   }
   if (json) {
     std::cout << list.dump(2) << "\n";
@@ -68,6 +86,9 @@ int run_filters_list(bool json) {
     std::cout << "\n";
     for (const auto& r : f["refuses"])
       std::cout << "    not " << r["model"].get<std::string>() << ": " << r["reason"].get<std::string>() << "\n";
+    for (const auto& o : f["options"])
+      std::cout << "    " << o["name"].get<std::string>() << " (default " << o["default"].dump() << "): "
+                << o["help"].get<std::string>() << "\n";
   }
   return 0;
 }
@@ -75,10 +96,10 @@ int run_filters_list(bool json) {
 int run_version() {
   const std::string backend = selected_backend();
   KokkosSession kokkos;
-  const nlohmann::json b = describe_backend(backend);
-  std::cout << version_string() << "\nKokkos " << b["kokkos"].get<std::string>() << "\nbackend: " << backend;
-  if (b.contains("threads")) std::cout << " (" << b["threads"] << " threads)";
-  if (b.contains("device")) std::cout << " (device: " << b["device"].get<std::string>() << ")";
+  const BackendDescription b = describe_backend(backend);
+  std::cout << version_string() << "\nKokkos " << b.kokkos << "\nbackend: " << backend;
+  if (b.threads > 0) std::cout << " (" << b.threads << " threads)";
+  if (!b.device.empty()) std::cout << " (device: " << b.device << ")";
   std::cout << "\navailable backends:";
   for (const auto& n : available_backends()) std::cout << " " << n;
   std::cout << " (select with KUSHNER_BACKEND)\n";

@@ -1,8 +1,8 @@
 // kushner: banks of nonlinear stochastic systems and filters. Command-line entry point.
-#include "drivers/backend.hpp"
+#include "engine/backend.hpp"
 #include "drivers/commands.hpp"
 #include "drivers/config_file.hpp"
-#include "kernels/errors.hpp"
+#include "core/errors.hpp"
 
 #include <CLI/CLI.hpp>
 

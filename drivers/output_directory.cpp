@@ -1,6 +1,6 @@
 #include "drivers/output_directory.hpp"
 
-#include "kernels/errors.hpp"
+#include "core/errors.hpp"
 
 #include <cerrno>
 #include <cstring>

@@ -1,18 +1,23 @@
 #include "drivers/run_metadata.hpp"
 
-#include "drivers/backend.hpp"
-#include "kushner_version.hpp"
+#include "engine/backend.hpp"
+#include "engine/version.hpp"
 
 namespace kushner {
 
-std::string version_string() { return std::string("kushner ") + KUSHNER_VERSION_STRING + " (git " + KUSHNER_GIT_HASH + ")"; }
+nlohmann::json backend_json(const BackendDescription& d) {
+  nlohmann::json j = {{"name", d.name}, {"kokkos", d.kokkos}};
+  if (!d.device.empty()) j["device"] = d.device;
+  if (d.threads > 0) j["threads"] = d.threads;
+  return j;
+}
 
 nlohmann::json run_metadata(const RunContext& context) {
   return {{"command", context.command},
           {"seed", context.seed},
-          {"version", KUSHNER_VERSION_STRING},
-          {"git", KUSHNER_GIT_HASH},
-          {"backend", describe_backend(context.backend)}};
+          {"version", version_number()},
+          {"git", git_hash()},
+          {"backend", backend_json(describe_backend(context.backend))}};
 }
 
 std::string csv_comment(const RunContext& context) {

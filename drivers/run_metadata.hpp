@@ -1,5 +1,8 @@
 #pragma once
 // What every output file records about the run that made it: command, seed, version, backend.
+#include "engine/backend.hpp"
+#include "engine/version.hpp"
+
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
@@ -13,8 +16,8 @@ struct RunContext {
   std::string backend;  // an available_backends() name
 };
 
-/// "kushner 0.1.0 (git <hash>)"
-std::string version_string();
+/// {"name", "kokkos", "threads" or "device"}
+nlohmann::json backend_json(const BackendDescription& description);
 
 /// {"command", "seed", "version", "git", "backend": describe_backend(...)}; needs Kokkos initialized.
 nlohmann::json run_metadata(const RunContext& context);

@@ -1,6 +1,6 @@
 #include "drivers/run_options.hpp"
 
-#include "kernels/errors.hpp"
+#include "core/errors.hpp"
 
 #include <cmath>
 #include <limits>
@@ -37,22 +37,13 @@ void validate_run_options(const RunOptions& o) {
   KUSHNER_INPUT_REQUIRE(std::isfinite(o.T) && o.T > 0.0, "--T: must be positive (got " << o.T << ")");
   KUSHNER_INPUT_REQUIRE(o.seed >= 0 && o.seed <= 0xffffffffLL, "--seed: must be in 0 .. 4294967295 (got " << o.seed << ")");
   KUSHNER_INPUT_REQUIRE(o.output_points > 0, "--output-points: must be positive (got " << o.output_points << ")");
-  make_time_grid(o.T, o.dt, o.output_points);
-}
-
-TimeGrid make_time_grid(double T, double dt, int output_points) {
-  const double ratio = T / dt;
-  KUSHNER_INPUT_REQUIRE(ratio >= 0.5, "--dt: larger than --T (" << dt << " > " << T << ")");
-  KUSHNER_INPUT_REQUIRE(ratio < 4.0e9, "--dt: too small for --T (" << ratio << " steps; at most 4e9)");
-  TimeGrid grid;
-  grid.steps = std::lround(ratio);
-  KUSHNER_INPUT_REQUIRE(std::fabs(ratio - grid.steps) <= 1e-9 * ratio,
+  const double ratio = o.T / o.dt;
+  const TimeGridProblem problem = time_grid_problem(o.T, o.dt);
+  KUSHNER_INPUT_REQUIRE(problem != TimeGridProblem::dt_above_T, "--dt: larger than --T (" << o.dt << " > " << o.T << ")");
+  KUSHNER_INPUT_REQUIRE(problem != TimeGridProblem::too_many_steps,
+                        "--dt: too small for --T (" << ratio << " steps; at most 4e9)");
+  KUSHNER_INPUT_REQUIRE(problem != TimeGridProblem::not_whole_steps,
                         "--T: must be a whole number of --dt steps (T/dt = " << ratio << ")");
-  grid.dt = dt;
-  const long stride = std::max(1L, grid.steps / output_points);
-  for (long k = 0; k < grid.steps; k += stride) grid.output_steps.push_back(k);
-  grid.output_steps.push_back(grid.steps);
-  return grid;
 }
 
 }  // namespace kushner

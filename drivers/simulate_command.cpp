@@ -1,9 +1,10 @@
-#include "drivers/backend.hpp"
+#include "engine/backend.hpp"
 #include "drivers/commands.hpp"
 #include "drivers/csv.hpp"
 #include "drivers/output_directory.hpp"
-#include "drivers/simulate_ensemble.hpp"
-#include "models/registry.hpp"
+#include "drivers/progress.hpp"
+#include "engine/truth_bank.hpp"
+#include "drivers/run_model.hpp"
 
 namespace kushner {
 
@@ -36,7 +37,7 @@ int run_simulate(const RunOptions& options, const RunContext& context) {
     with_backend(context.backend, [&](const auto& space) {
       Progress progress("simulate", grid.steps, !options.quiet);
       const MomentSeries series = simulate_ensemble(space, model, options.members,
-                                                    static_cast<std::uint32_t>(options.seed), grid, &progress);
+                                                    static_cast<std::uint32_t>(options.seed), grid, [&](long done) { progress.update(done); });
       nlohmann::json summary = run_metadata(context);
       summary["model"] = model_summary(model);
       summary["members"] = options.members;

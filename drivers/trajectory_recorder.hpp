@@ -4,13 +4,11 @@
 // 1-D models the particle density of the first chosen member against each filter's Gaussian at chosen times
 // (density.csv). Only those members are copied to the host, so it costs little next to the run.
 #include "drivers/csv.hpp"
-#include "drivers/filter_bank.hpp"
-#include "drivers/particle_reference.hpp"
-#include "drivers/reference_estimator.hpp"
+#include "engine/filter_bank.hpp"
+#include "engine/reference_estimator.hpp"
 #include "drivers/run_metadata.hpp"
-#include "kernels/errors.hpp"
+#include "core/errors.hpp"
 #include "kernels/host_copy.hpp"
-#include "kernels/particle_filter/particle_snapshot.hpp"
 
 #include <Kokkos_Core.hpp>
 
@@ -46,14 +44,13 @@ class TrajectoryRecorder {
                   const std::vector<const ReferenceEstimator<MemSpace>*>& outside) {
     std::vector<int> members(members_.begin(), members_.end());
     if (members.empty()) return;
-    const ReferenceEstimator<MemSpace>* pf = nullptr;  // the particle filter among `outside`, if any
+    const ReferenceEstimator<MemSpace>* pf = nullptr;  // the first estimator among `outside` made of particles
     std::optional<ParticleSnapshot> snapshot;          // its particles of `members`
-    if constexpr (particle_filter_unsupported<Model>() == nullptr)
-      for (const auto* e : outside)
-        if (const auto* p = dynamic_cast<const ParticleReference<ExecSpace, Model>*>(e); p && !pf) {
-          pf = e;
-          snapshot.emplace(p->bank(), members);
-        }
+    for (const auto* e : outside) {
+      if (pf) break;
+      snapshot = e->particle_snapshot(members);
+      if (snapshot) pf = e;
+    }
     const bool density =
         n == 1 && pf && next_density_ < density_times_.size() && t >= density_times_[next_density_] - 1e-9;
     for (int member : members) {
@@ -67,7 +64,7 @@ class TrajectoryRecorder {
           const auto mean = row(pf->mean(), member);
           for (int i = 0; i < n; ++i) {
             const std::vector<double> band = snapshot->quantiles(member, i, {0.05, 0.95});
-            add_trajectory(member, t, i, "PF", mean(i), band[0], band[1]);
+            add_trajectory(member, t, i, pf->name(), mean(i), band[0], band[1]);
           }
         } else {
           add_gaussian(member, t, e->name(), row(e->mean(), member), row(e->covariance(), member));
@@ -118,7 +115,7 @@ class TrajectoryRecorder {
       density_ += format_number(t) + "," + std::to_string(member) + "," + format_number(x) + "," + series + "," +
                   format_number(d) + "\n";
     };
-    for (int b = 0; b < density_bins; ++b) add("PF", lo + (b + 0.5) * width, histogram[b]);
+    for (int b = 0; b < density_bins; ++b) add(pf.name(), lo + (b + 0.5) * width, histogram[b]);
     auto bell = [&](const std::string& name, double mean, double variance) {
       if (!(variance > 0.0)) return;
       for (int b = 0; b < density_bins; ++b) {

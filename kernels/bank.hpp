@@ -3,7 +3,7 @@
 // member's small vectors and matrices. LayoutLeft is spelled out because the default layout differs between
 // backends; with it x(member, i) is stride-1 in member, and particles(particle, member, i) is stride-1 in
 // particle within a member.
-#include "kernels/small_matrix.hpp"
+#include "core/small_matrix.hpp"
 
 #include <Kokkos_Core.hpp>
 

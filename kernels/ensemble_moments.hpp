@@ -5,7 +5,7 @@
 // partial sums in an order that depends on the thread count. Members with a non-finite entry (a path that
 // escaped to infinity) are left out and counted.
 #include "kernels/bank.hpp"
-#include "kernels/math.hpp"
+#include "core/math.hpp"
 
 #include <Kokkos_Core.hpp>
 

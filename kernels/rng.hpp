@@ -11,8 +11,8 @@
 // not a rejection method, so every member uses the same number of blocks per step and counters stay aligned.
 // The truths take component i of their N normals from block i / 2 (normal_vector); the particle filter
 // gives both normals of a block to two particles (kernels/particle_filter/particle_draws.hpp).
-#include "kernels/math.hpp"
-#include "kernels/small_matrix.hpp"
+#include "core/math.hpp"
+#include "core/small_matrix.hpp"
 
 #include <Random123/philox.h>
 
@@ -50,7 +50,7 @@ KOKKOS_INLINE_FUNCTION r123array4x32 philox_block(const RngKey& key, const Count
 /// Uniform in the open interval (0, 1) from two 32-bit words: the top 52 bits, offset by half a step, so
 /// that neither 0 (log in Box-Muller) nor 1 can occur: (k + 1/2) 2^-52, k = 0 .. 2^52 - 1.
 KOKKOS_INLINE_FUNCTION double uniform_open(std::uint32_t hi, std::uint32_t lo) {
-#if defined(__CUDA_ARCH__)
+#if KUSHNER_CUDA_DEVICE_PASS
   // The same value from its bit pattern, as simd::uniform_open: 1 + k 2^-52 minus 1 - 2^-53, both exact
   // (Sterbenz). A GPU converts 64-bit integers to double at a quarter of its fp64 rate; this costs 32-bit
   // integer operations and one subtraction.

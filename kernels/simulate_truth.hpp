@@ -3,7 +3,7 @@
 // take an Euler-Maruyama step and produce the observation increment dy over the step; discrete-time models
 // take x[k+1] = F(k, x[k], u) + w[k] and produce z[k+1] = H x[k+1] + v[k+1] in the same bank.
 #include "kernels/bank.hpp"
-#include "kernels/errors.hpp"
+#include "core/errors.hpp"
 #include "kernels/for_each_member.hpp"
 #include "kernels/rng.hpp"
 

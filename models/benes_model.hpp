@@ -7,8 +7,8 @@
 //   p(x' | x) = cosh(x') N(x'; x, dt) / (e^{dt/2} cosh x) = w+ N(x + dt, dt) + w- N(x - dt, dt),
 // w+- = (1 +- tanh x) / 2, so the particle filter samples it exactly (sample_exact_transition).
 // Ours: r = 0.5, x(0) ~ N(0.5, 1) for truths and prior alike.
-#include "kernels/math.hpp"
-#include "kernels/small_matrix.hpp"
+#include "core/math.hpp"
+#include "core/small_matrix.hpp"
 #include "models/drift_forms.hpp"
 #include "models/initial_law.hpp"
 

@@ -1,7 +1,7 @@
 #pragma once
 // Clark's bounded non-Gaussian noise (seed 003, eq. (4.4)): density (rho + 1) / (2 c) |y / c|^rho on |y| < c.
 // rho = 0 is uniform on (-c, c); rho = 10 is Clark's "inverted bell" plant noise.
-#include "kernels/math.hpp"
+#include "core/math.hpp"
 
 namespace kushner {
 

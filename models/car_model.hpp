@@ -8,9 +8,9 @@
 // m(0) = (10, 0.1), P(0) = [[100, 10], [10, 1]] (singular: every filter here works without P^{-1}), V = I
 // (r = 1), no process noise (q = 0). The paper "realizes" the observation noises as sin t; here they are
 // Brownian. Time-varying steering inputs are not modelled: u is constant.
-#include "kernels/errors.hpp"
-#include "kernels/math.hpp"
-#include "kernels/small_matrix.hpp"
+#include "core/errors.hpp"
+#include "core/math.hpp"
+#include "core/small_matrix.hpp"
 #include "models/drift_forms.hpp"
 #include "models/initial_law.hpp"
 

@@ -3,8 +3,8 @@
 // non-Gaussian noise,  x[k+1] = a x[k] + u[k] + w[k],  z[k+1] = x[k+1] + v[k+1],
 // w with density (11/2) w^10 on |w| < 1 (rho_w = 10), v uniform on (-1, 1) (rho_v = 0). a = 0.1.
 // The thesis does not state x[0]; ours: x[0] = 0 for the truths, the filters' prior N(0, 1).
-#include "kernels/errors.hpp"
-#include "kernels/small_matrix.hpp"
+#include "core/errors.hpp"
+#include "core/small_matrix.hpp"
 #include "models/bounded_noise.hpp"
 #include "models/initial_law.hpp"
 

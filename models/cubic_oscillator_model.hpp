@@ -7,7 +7,7 @@
 // printed start). The paper gives neither q, r nor the filters' initial covariance; ours: q = r = 0.5,
 // prior N(0, I). Even so, a few percent of noisy paths escape over long horizons: such members are counted
 // as diverged, not averaged in.
-#include "kernels/small_matrix.hpp"
+#include "core/small_matrix.hpp"
 #include "models/drift_forms.hpp"
 #include "models/initial_law.hpp"
 

@@ -6,7 +6,7 @@
 //   QuadraticPolynomial  f_k = a0_k + sum_i a1_ki x_i + sum c x_i x_j       (Basin bilinear, seed 002 ACC03 (13))
 //   SdcDrift             f = A(x) x + b                                      (Cimen-Banks ASRE, seed 001 (4))
 //   GaussianDrift        E_N[f], E_N[grad f] under x ~ N(m, P)               (Sunahara QLF, seed 000 (5.3)-(5.4))
-#include "kernels/small_matrix.hpp"
+#include "core/small_matrix.hpp"
 
 namespace kushner {
 
@@ -42,7 +42,7 @@ struct PowerPolynomial {
 };
 
 /// The terms of p up to degree D (all of p when its degree is at most D). Only for a p whose higher
-/// coefficients are known to vanish (a run-time polynomial checked by its filter_unsupported()).
+/// coefficients are known to vanish (a run-time polynomial whose drift_facts() say so).
 template <int D, int N, int Degree>
 KOKKOS_INLINE_FUNCTION PowerPolynomial<N, (D < Degree ? D : Degree)> truncated(const PowerPolynomial<N, Degree>& p) {
   constexpr int degree = D < Degree ? D : Degree;

@@ -2,7 +2,7 @@
 // Gaussian initial laws shared by every continuous-time model: the truths start from N(x0_mean, x0_cov), the
 // filters from their prior N(prior_mean, prior_cov). They coincide unless a model (e.g. Sunahara's Example 2,
 // whose truth starts at a fixed point far from the filters' prior) or the user sets them apart.
-#include "kernels/small_matrix.hpp"
+#include "core/small_matrix.hpp"
 
 namespace kushner {
 

@@ -4,7 +4,7 @@
 // Default: a damped rotation A = -0.5 I + J (J: +1 above, -1 below the diagonal), b = 0.5 I, C = I,
 // R = 0.5 I, a0 = c0 = 0, x(0) ~ N(1, 0.1 I) for truths and prior alike. All matrices are settable.
 // The observation has the state's dimension; a partial observation is a row of C set to zero.
-#include "kernels/small_matrix.hpp"
+#include "core/small_matrix.hpp"
 #include "models/drift_forms.hpp"
 #include "models/initial_law.hpp"
 

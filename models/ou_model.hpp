@@ -2,7 +2,7 @@
 // Scalar Ornstein-Uhlenbeck process observed in white noise: the simplest model with exact moments,
 //   dx = -theta (x - mu) dt + sigma dw,   dy = x dt + r dv.
 // E[x(t)] = mu + (m0 - mu) e^{-theta t},  Var[x(t)] = P0 e^{-2 theta t} + sigma^2 (1 - e^{-2 theta t}) / (2 theta).
-#include "kernels/small_matrix.hpp"
+#include "core/small_matrix.hpp"
 #include "models/drift_forms.hpp"
 #include "models/initial_law.hpp"
 

@@ -2,8 +2,8 @@
 // Host side of model parameters: `--set key=value` parsing and application, listing, and JSON records.
 // A model exposes its parameters once, through `template <class V> void parameters(V&& v)` calling
 // v(name, field, description) for double, Vec<N> and Mat<R, C> fields; every visitor below serves all models.
-#include "kernels/errors.hpp"
-#include "kernels/small_matrix.hpp"
+#include "core/errors.hpp"
+#include "core/small_matrix.hpp"
 
 #include <nlohmann/json.hpp>
 

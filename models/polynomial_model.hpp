@@ -1,5 +1,5 @@
 #pragma once
-// A polynomial model defined at run time (`--model-file FILE`, models/model_file.hpp), state dimension N = 1..3:
+// A polynomial model defined at run time (`--model-file FILE`, drivers/model_file.hpp), state dimension N = 1..3:
 //   dx = f(x) dt + b dw,   dy = (c0 + C x) dt + R dv,
 //   f_k(x) = a0_k + sum_i a1_ki x_i + sum over the monomials x^alpha of degree 2..4 of c_k,alpha x^alpha.
 // The monomials are stored once each (x1 x2 is one term, not a2_k12 and a2_k21), in a fixed order: by degree,
@@ -9,13 +9,13 @@
 // the extra observation rows zero with unit noise (channels that carry no information: the posterior is the
 // same) and the extra diffusion columns zero (the same G G^T, and the first q noise draws are the ones a
 // q-column model takes). Which filters apply depends on the coefficients, so the model says why a filter
-// cannot run (`filter_unsupported`, checked when filters are selected) instead of the compile-time traits.
-#include "kernels/small_matrix.hpp"
+// cannot run (from `drift_facts()`, checked when filters are selected) instead of the compile-time traits.
+#include "core/small_matrix.hpp"
 #include "models/drift_forms.hpp"
+#include "models/drift_facts.hpp"
 #include "models/initial_law.hpp"
 #include "models/polynomial_monomials.hpp"
 
-#include <cstring>
 #include <type_traits>
 #include <utility>
 
@@ -166,7 +166,7 @@ struct PolynomialModel : InitialLaw<N> {
   }
 
   /// The componentwise-power part a0 + a1 x + sum_k a_k x^k (POLY3, POLY4): the whole drift when the model
-  /// has no cross terms of degree >= 2, which filter_unsupported checks before those filters run.
+  /// has no cross terms of degree >= 2, which the filters check in drift_facts() before they run.
   KOKKOS_INLINE_FUNCTION PowerPolynomial<N, 4> drift_power_polynomial(double) const {
     auto poly = PowerPolynomial<N, 4>::zero();
     poly.a0 = a0;
@@ -181,7 +181,7 @@ struct PolynomialModel : InitialLaw<N> {
   }
 
   static constexpr int num_quadratic_terms = N * N * (N + 1) / 2;
-  /// The part of degree <= 2 (BILIN): the whole drift when the degree is at most 2 (filter_unsupported).
+  /// The part of degree <= 2 (BILIN): the whole drift when the degree is at most 2 (drift_facts).
   KOKKOS_INLINE_FUNCTION QuadraticPolynomial<N, num_quadratic_terms> drift_quadratic_polynomial(double) const {
     QuadraticPolynomial<N, num_quadratic_terms> poly;
     poly.a0 = a0;
@@ -208,7 +208,7 @@ struct PolynomialModel : InitialLaw<N> {
     return s;
   }
 
-  /// The linear part (Kalman-Bucy): the whole model when the drift has degree <= 1 (filter_unsupported).
+  /// The linear part (Kalman-Bucy): the whole model when the drift has degree <= 1 (drift_facts).
   KOKKOS_INLINE_FUNCTION LinearForm<N, N> linear_form(double) const { return {a0, a1, c0, C}; }
 
   // ---- one monomial's terms (member templates, so that nested compile-time loops see only template
@@ -259,48 +259,25 @@ struct PolynomialModel : InitialLaw<N> {
     });
   }
 
-  // ---- host: the structure of the coefficients, and which filters it rules out --------------------------
-  /// Highest degree with a nonzero coefficient (0 for a constant drift).
-  int degree() const {
-    int d = 0;
+  // ---- host: what the coefficients are (filters decide from these facts whether they can run them) ------
+  DriftFacts drift_facts() const {
+    DriftFacts f;
     for (int i = 0; i < N; ++i)
       for (int j = 0; j < N; ++j)
-        if (a1(i, j) != 0.0) d = 1;
-    for (int t = 0; t < num_monomials; ++t)
-      for (int k = 0; k < N; ++k)
-        if (coefficient[k][t] != 0.0 && polynomial_monomial(N, t).degree > d) d = polynomial_monomial(N, t).degree;
-    return d;
-  }
-  /// Whether a monomial of degree >= 2 with two different variables (x1 x2, x1^2 x3, ...) has a nonzero
-  /// coefficient.
-  bool has_cross_terms() const {
+        if (a1(i, j) != 0.0) f.degree = 1;
     for (int t = 0; t < num_monomials; ++t) {
       const Monomial m = polynomial_monomial(N, t);
-      if (m.var[0] == m.var[m.degree - 1]) continue;
-      for (int k = 0; k < N; ++k)
-        if (coefficient[k][t] != 0.0) return true;
+      for (int k = 0; k < N; ++k) {
+        if (coefficient[k][t] == 0.0) continue;
+        f.degree = m.degree > f.degree ? m.degree : f.degree;
+        f.cross_terms = f.cross_terms || m.var[0] != m.var[m.degree - 1];
+      }
     }
-    return false;
-  }
-  /// Whether b b^T is diagonal (the grid filter's axis-aligned noise).
-  bool axis_aligned_noise() const {
     const Mat<N, N> q = b * transpose(b);
     for (int i = 0; i < N; ++i)
       for (int j = 0; j < N; ++j)
-        if (i != j && q(i, j) != 0.0) return false;
-    return true;
-  }
-
-  /// Why the filter called `filter` cannot run these coefficients, or nullptr (drivers/filter_selection.hpp).
-  const char* filter_unsupported(const char* filter) const {
-    const auto is = [&](const char* name) { return std::strcmp(filter, name) == 0; };
-    if (is("KB") && degree() > 1) return "drift is not linear (the file has terms of degree 2 or more)";
-    if ((is("POLY3") || is("POLY4")) && has_cross_terms())
-      return "drift has cross terms (monomials of two or more variables), not componentwise powers";
-    if (is("POLY3") && degree() > 3) return "drift has degree above 3";
-    if (is("BILIN") && degree() > 2) return "drift is not bilinear (degree above 2)";
-    if (is("EXACT") && !axis_aligned_noise()) return "the grid filter needs axis-aligned noise (b b^T diagonal)";
-    return nullptr;
+        if (i != j && q(i, j) != 0.0) f.axis_aligned_noise = false;
+    return f;
   }
 };
 

@@ -1,5 +1,5 @@
 #pragma once
-// `--model-file FILE`: what a polynomial model file (models/polynomial_model.hpp, models/model_file.hpp) holds,
+// `--model-file FILE`: what a polynomial model file (models/polynomial_model.hpp, drivers/model_file.hpp) holds,
 // read from TOML by models/model_file.cpp (toml++). Plain C++ without Kokkos: in CUDA builds that parser is
 // compiled by the host compiler alone (toml++ does not get through nvcc). The format, with n = state_dim (1..3):
 //   state_dim = 2                    # required

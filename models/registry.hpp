@@ -2,14 +2,13 @@
 // The one place where a model name becomes a type. Commands call with_model(name, sets, f): the model is
 // built, its `--set key=value` assignments applied and checked, and f(model) called with the concrete type,
 // so everything downstream is dispatched at compile time.
-#include "kernels/errors.hpp"
+#include "core/errors.hpp"
 #include "models/benes_model.hpp"
 #include "models/car_model.hpp"
 #include "models/clark_linear_model.hpp"
 #include "models/cubic_oscillator_model.hpp"
 #include "models/linear_model.hpp"
 #include "models/model_checks.hpp"
-#include "models/model_file.hpp"
 #include "models/ou_model.hpp"
 #include "models/parameters.hpp"
 #include "models/sine_model.hpp"
@@ -103,34 +102,6 @@ void with_model(const std::string& name, const std::vector<std::string>& sets, F
   std::string known;
   for (const auto& n : model_names()) known += (known.empty() ? "" : ", ") + n;
   throw InputError("--model: unknown model '" + name + "' (known: " + known + ")");
-}
-
-/// The model of a run: `--model-file FILE` (a polynomial model, models/model_file.hpp) when given, else the
-/// built-in `--model NAME`; calls f(model) as with_model does.
-template <class F>
-void with_run_model(const std::string& name, const std::string& model_file, const std::vector<std::string>& sets,
-                    F&& f) {
-  if (model_file.empty())
-    with_model(name, sets, f);
-  else
-    with_model_file(model_file, sets, f);
-}
-
-/// summary.json's "model" entry: name, state_dim and parameters; for a polynomial model from a file also the
-/// file and every coefficient as it runs (polynomial_model_json).
-template <class Model>
-nlohmann::json model_summary(const Model& model) {
-  nlohmann::json j = {{"name", Model::name}, {"state_dim", Model::state_dim}, {"parameters", parameter_values(model)}};
-  if constexpr (is_polynomial_model<Model>::value) {
-    nlohmann::json polynomial = polynomial_model_json(model);
-    for (const char* key : {"file", "label", "description"})
-      if (polynomial.contains(key)) {
-        j[key] = polynomial[key];
-        polynomial.erase(key);
-      }
-    j["polynomial"] = polynomial;
-  }
-  return j;
 }
 
 }  // namespace kushner

@@ -2,8 +2,8 @@
 // Sunahara (1968) Example 1, seed 000 eqs. (6.1)-(6.3):  dx = -sin(x) dt + q dw,  dy = x dt + r dv.
 // The paper gives no noise levels or initial law (figures only); ours, stated in the README: q = 1, r = 0.5,
 // x(0) ~ N(1, 1) for the truths and the filters' prior alike.
-#include "kernels/math.hpp"
-#include "kernels/small_matrix.hpp"
+#include "core/math.hpp"
+#include "core/small_matrix.hpp"
 #include "models/drift_forms.hpp"
 #include "models/initial_law.hpp"
 

@@ -6,8 +6,8 @@
 // that dy does not depend on how the step is split). The filters keep Model, whose V = R R^T they use in the
 // gain as the intensity of a white noise; the process noise stays Brownian (q = 0 in both examples). Every
 // member then sees the same observations: with a fixed initial state, all members are one deterministic run.
-#include "kernels/math.hpp"
-#include "kernels/small_matrix.hpp"
+#include "core/math.hpp"
+#include "core/small_matrix.hpp"
 
 namespace kushner {
 

@@ -6,8 +6,8 @@
 // K_L3 are listed there but do not occur in (18)); truth from x(0) = 0, filters from m(0) = 0.5, P(0) = I.
 // The paper has no state noise (q = 0) and "realizes" the observation noises as sin t; here they are Brownian
 // with V = I (r = 1, the gain printed as P). It states no horizon.
-#include "kernels/errors.hpp"
-#include "kernels/small_matrix.hpp"
+#include "core/errors.hpp"
+#include "core/small_matrix.hpp"
 #include "models/drift_forms.hpp"
 #include "models/initial_law.hpp"
 

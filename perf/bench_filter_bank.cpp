@@ -1,8 +1,8 @@
 // The whole filter bank's step (truths + every filter the model supports, one fused kernel): member-steps per
 // second, next to the truth step alone in the same binary. ASRE runs a fixed 8 iterates per member (its
 // convergence passes are not part of a step; the seed models need 5-8 on average at tolerance 1e-6).
-#include "drivers/filter_bank.hpp"
-#include "drivers/filter_selection.hpp"
+#include "engine/filter_bank.hpp"
+#include "kernels/filters/filter_list.hpp"
 #include "models/cubic_oscillator_model.hpp"
 #include "models/sine_model.hpp"
 
@@ -20,10 +20,10 @@ template <class Model>
 void BM_FilterBankStep(benchmark::State& state) {
   const long members = state.range(0);
   const Space space;
-  const std::vector<std::string> filters = select_filters<Model>("all");
-  FilterConfig config;
-  config.asre_iterations.assign(members, asre_iterates);
-  FilterBank<Space, Model> bank(space, Model{}, Model{}, members, 42, filters, config);
+  const std::vector<std::string> filters = supported_filters(Model{});
+  OptionValues settings;
+  settings.set("asre_max_iterations", static_cast<long>(asre_iterates));
+  FilterBank<Space, Model> bank(space, Model{}, Model{}, members, 42, filters, settings);
   long k = 0;
   for (auto _ : state) {
     space.fence();

@@ -3,8 +3,8 @@
 // must move (the memory floor) in the same binary. Observation increments come from a bank of truths that
 // is stepped outside the timed region. With steps = 2 each timed call is ParticleFilterBank::step_pair (two
 // steps, one pass over the particles on a GPU: half the bytes per particle-step).
-#include "drivers/simulate_ensemble.hpp"
-#include "kernels/particle_filter/particle_filter_bank.hpp"
+#include "engine/truth_bank.hpp"
+#include "engine/particle_filter_bank.hpp"
 #include "models/sine_model.hpp"
 
 #include <benchmark/benchmark.h>

@@ -2,7 +2,7 @@
 // steps): the Kokkos team kernel (fixed-order blocked scan + per-particle systematic intervals) against a
 // Thrust version (segmented inclusive_scan_by_key + vectorized upper_bound) where CUDA and Thrust are
 // built in. The particle filter keeps the Kokkos kernel unless this measurement says otherwise.
-#include "drivers/backend.hpp"
+#include "engine/backend.hpp"
 #include "kernels/particle_filter/resampling.hpp"
 
 #include <benchmark/benchmark.h>

@@ -1,6 +1,6 @@
 // Truth simulation step (Euler-Maruyama, all members in one kernel): member-steps per second, next to a
 // deep_copy of the same bytes (the memory floor) in the same binary.
-#include "drivers/simulate_ensemble.hpp"
+#include "engine/truth_bank.hpp"
 #include "models/cubic_oscillator_model.hpp"
 #include "models/sine_model.hpp"
 

@@ -4,9 +4,9 @@
 // threads from OMP_NUM_THREADS, as for the kushner command. `particle_filter_dump car` prints Basin's car
 // instead (no process noise: tan drift, deterministic particles between resamplings), for looking at how a
 // GPU run departs from a host one.
-#include "drivers/backend.hpp"
-#include "drivers/simulate_ensemble.hpp"
-#include "kernels/particle_filter/particle_filter_bank.hpp"
+#include "engine/backend.hpp"
+#include "engine/truth_bank.hpp"
+#include "engine/particle_filter_bank.hpp"
 #include "models/car_model.hpp"
 #include "models/cubic_oscillator_model.hpp"
 #include "models/linear_model.hpp"

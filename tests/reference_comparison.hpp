@@ -2,7 +2,7 @@
 // Helpers for the statistical tests that compare the particle filter with exact and grid references: record
 // one bank of observation increments, replay it into any estimator with step(k, dt, dy) and
 // posterior_mean(), and summarize the differences.
-#include "drivers/simulate_ensemble.hpp"
+#include "engine/truth_bank.hpp"
 
 #include <Kokkos_Core.hpp>
 

@@ -5,7 +5,7 @@
 // - the iteration over the horizon stops per member at the first iterate that changed less than the
 //   tolerance; on a linear model that is iterate 1 (A(x) = A: iterate 1 repeats iterate 0);
 // - an unreachable tolerance leaves every member at the maximum and reports it as not converged.
-#include "drivers/filter_run.hpp"
+#include "engine/filter_run.hpp"
 #include "models/linear_model.hpp"
 #include "models/sine_model.hpp"
 
@@ -24,9 +24,9 @@ TEST(AsreFilter, IterateIEqualsTheCausalSdcFilterOnTheFirstIPlusOneSteps) {
   constexpr long members = 16;
   constexpr int iterations = 5;
   constexpr double dt = 0.01;
-  FilterConfig config;
-  config.asre_max_iterations = iterations;
-  FilterBank<Space, SineModel> bank(Space(), model, model, members, 3, {"ASRE"}, config);
+  OptionValues settings;
+  settings.set("asre_max_iterations", static_cast<long>(iterations));
+  FilterBank<Space, SineModel> bank(Space(), model, model, members, 3, {"ASRE"}, settings);
   std::vector<double> m(members, model.prior_mean[0]), P(members, model.prior_cov(0, 0));
   const double r2 = model.r * model.r, q2 = model.q * model.q;
   for (long k = 0; k < 30; ++k) {
@@ -55,22 +55,26 @@ TEST(AsreFilter, IterateIEqualsTheCausalSdcFilterOnTheFirstIPlusOneSteps) {
 
 TEST(AsreFilter, StopsAtTheFirstIterateWithinTheTolerance) {
   const TimeGrid grid = make_time_grid(2.0, 0.01, 2);
-  FilterConfig config;
-  const FilterReport sine = run_filters(Space(), SineModel{}, SineModel{}, 500, 5, grid, {"ASRE"}, config);
-  EXPECT_EQ(sine.asre.not_converged, 0);
-  EXPECT_GE(sine.asre.min, 2);  // sin(x)/x is not constant: iterate 1 differs from iterate 0
-  EXPECT_LT(sine.asre.max, config.asre_max_iterations);
+  const auto iterations = [](const FilterReport& report, const char* key) {
+    return std::get<long>(*find_field(report.filter_fields.at("ASRE"), std::string("iterations.") + key));
+  };
+  OptionValues settings;
+  const FilterReport sine = run_filters(Space(), SineModel{}, SineModel{}, 500, 5, grid, {"ASRE"}, settings);
+  EXPECT_EQ(iterations(sine, "not_converged"), 0);
+  EXPECT_GE(iterations(sine, "min"), 2);  // sin(x)/x is not constant: iterate 1 differs from iterate 0
+  EXPECT_LT(iterations(sine, "max"), iterations(sine, "max_iterations"));
+  EXPECT_EQ(iterations(sine, "max_iterations"), 30) << "the declared default";
   EXPECT_EQ(sine.scores[0].diverged, 0);
 
-  const FilterReport linear = run_filters(Space(), LinearModel<2>{}, LinearModel<2>{}, 500, 5, grid, {"ASRE"}, config);
-  EXPECT_EQ(linear.asre.min, 1);
-  EXPECT_EQ(linear.asre.max, 1);
+  const FilterReport linear = run_filters(Space(), LinearModel<2>{}, LinearModel<2>{}, 500, 5, grid, {"ASRE"}, settings);
+  EXPECT_EQ(iterations(linear, "min"), 1);
+  EXPECT_EQ(iterations(linear, "max"), 1);
 
-  config.asre_tolerance = 1e-300;
-  config.asre_max_iterations = 4;
-  const FilterReport never = run_filters(Space(), SineModel{}, SineModel{}, 500, 5, grid, {"ASRE"}, config);
-  EXPECT_EQ(never.asre.not_converged, 500);
-  EXPECT_EQ(never.asre.min, 4);
+  settings.set("asre_tolerance", 1e-300);
+  settings.set("asre_max_iterations", 4L);
+  const FilterReport never = run_filters(Space(), SineModel{}, SineModel{}, 500, 5, grid, {"ASRE"}, settings);
+  EXPECT_EQ(iterations(never, "not_converged"), 500);
+  EXPECT_EQ(iterations(never, "min"), 4);
 }
 
 }  // namespace

@@ -2,8 +2,8 @@
 // NEES over time and 10^4 members is the state dimension to within 3 standard errors (the bank's step is
 // the exact Kalman filter of the Euler-Maruyama truths, so E[NEES] = n at every time, not just as dt -> 0).
 // Power: a filter that assumes half the process noise intensity must fail the same test.
-#include "drivers/filter_run.hpp"
-#include "drivers/filter_selection.hpp"
+#include "engine/filter_run.hpp"
+#include "kernels/filters/filter_list.hpp"
 #include "models/linear_model.hpp"
 
 #include <gtest/gtest.h>
@@ -20,7 +20,7 @@ constexpr long num_members = 10000;
 template <int N>
 Estimate kalman_bucy_nees(const LinearModel<N>& truth, const LinearModel<N>& filter) {
   const TimeGrid grid = make_time_grid(2.0, 0.01, 4);
-  const FilterReport report = run_filters(Space(), truth, filter, num_members, seed, grid, {"KB"}, FilterConfig{});
+  const FilterReport report = run_filters(Space(), truth, filter, num_members, seed, grid, {"KB"});
   EXPECT_EQ(report.scores[0].diverged, 0);
   EXPECT_EQ(report.scores[0].nees.members, num_members);
   return report.scores[0].nees;

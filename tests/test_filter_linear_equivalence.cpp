@@ -3,8 +3,8 @@
 // (polynomials of degree 1), ASRE (A(x) = A at every iterate) and KBL (the model is its own linearization).
 // Checked to 1e-10 relative, every step, every member, in dimension 1 and 3, with affine drift and
 // observation terms (which the known-input forms of ASRE and the polynomial filters must carry).
-#include "drivers/filter_bank.hpp"
-#include "drivers/filter_selection.hpp"
+#include "engine/filter_bank.hpp"
+#include "kernels/filters/filter_list.hpp"
 #include "models/linear_model.hpp"
 #include "tests/filter_test_helpers.hpp"
 
@@ -40,13 +40,13 @@ LinearModel<3> linear_3d() {
 template <class Model>
 void expect_every_filter_equals_kalman_bucy(const Model& model, Expectations qlf_expectations) {
   using Space = Kokkos::DefaultExecutionSpace;
-  FilterConfig config;
-  config.qlf_expectations = qlf_expectations;
-  config.gh_nodes = 5;
-  config.asre_max_iterations = 3;
-  const std::vector<std::string> filters = select_filters<Model>("all");
-  ASSERT_EQ(filters.size(), 12u) << "every filter supports a linear model";
-  FilterBank<Space, Model> bank(Space(), model, model, num_members, 20261122, filters, config);
+  OptionValues settings;
+  settings.set("qlf_expectations", std::string(qlf_expectations == Expectations::closed ? "closed" : "cubature"));
+  settings.set("gh_nodes", 5L);
+  settings.set("asre_max_iterations", 3L);
+  const std::vector<std::string> filters = supported_filters(model);
+  ASSERT_EQ(filters, all_filter_names()) << "every filter supports a linear model";
+  FilterBank<Space, Model> bank(Space(), model, model, num_members, 20261122, filters, settings);
   for (long k = 0; k < num_steps; ++k) {
     bank.step(k, dt, false);
     bank.with_slot("KB", [&](const auto& kb) {
@@ -77,8 +77,8 @@ TEST(FilterBankOnLinearModel, DifferentModelIsDetected) {
   using Space = Kokkos::DefaultExecutionSpace;
   LinearModel<3> other = linear_3d();
   other.A(0, 0) += 1e-6;
-  FilterBank<Space, LinearModel<3>> a(Space(), linear_3d(), linear_3d(), num_members, 7, {"KB"}, FilterConfig{});
-  FilterBank<Space, LinearModel<3>> b(Space(), linear_3d(), other, num_members, 7, {"KB"}, FilterConfig{});
+  FilterBank<Space, LinearModel<3>> a(Space(), linear_3d(), linear_3d(), num_members, 7, {"KB"});
+  FilterBank<Space, LinearModel<3>> b(Space(), linear_3d(), other, num_members, 7, {"KB"});
   for (long k = 0; k < 50; ++k) {
     a.step(k, dt, false);
     b.step(k, dt, false);

@@ -1,7 +1,7 @@
-// The reference seam (drivers/reference_estimator.hpp) that the particle filter plugs into: with the truths
+// The reference seam (engine/reference_estimator.hpp) that the particle filter plugs into: with the truths
 // themselves as the "reference", every filter's rmse_ref equals its rmse_truth exactly, and a reference that
 // is off by a constant shows up as that offset. An estimator added to the bank is scored like a filter.
-#include "drivers/filter_bank.hpp"
+#include "engine/filter_bank.hpp"
 #include "models/sine_model.hpp"
 
 #include <gtest/gtest.h>
@@ -29,7 +29,7 @@ class ShiftedTruth : public ReferenceEstimator<MemSpace> {
   BankVector<MemSpace> mean() const override { return mean_; }
   BankSymmetric<MemSpace> covariance() const override { return covariance_; }
   BankScalar<Status, MemSpace> status() const override { return status_; }
-  nlohmann::json describe() const override { return {{"kind", "test"}}; }
+  Fields describe() const override { return {{"kind", std::string("test")}}; }
 
  private:
   void copy() {
@@ -53,7 +53,7 @@ FilterScores run(Bank& bank, ReferenceEstimator<MemSpace>& reference, long steps
 
 TEST(FilterReference, TruthAsReferenceGivesRmseRefEqualToRmseTruth) {
   const SineModel model;
-  FilterBank<Space, SineModel> bank(Space(), model, model, 1000, 9, {"EKF", "QLF"}, FilterConfig{});
+  FilterBank<Space, SineModel> bank(Space(), model, model, 1000, 9, {"EKF", "QLF"});
   ShiftedTruth truth(bank.truths().state(), 0.0);
   const FilterScores ekf = run(bank, truth, 200, "EKF");
   EXPECT_EQ(ekf.rmse_ref.value, ekf.rmse_truth.value);
@@ -65,7 +65,7 @@ TEST(FilterReference, TruthAsReferenceGivesRmseRefEqualToRmseTruth) {
 
 TEST(FilterReference, ShiftedReferenceShowsTheShift) {
   const SineModel model;
-  FilterBank<Space, SineModel> bank(Space(), model, model, 1000, 9, {"EKF"}, FilterConfig{});
+  FilterBank<Space, SineModel> bank(Space(), model, model, 1000, 9, {"EKF"});
   ShiftedTruth shifted(bank.truths().state(), 10.0);
   const FilterScores ekf = run(bank, shifted, 200, "EKF");
   EXPECT_NEAR(ekf.rmse_ref.value, 10.0, 2 * ekf.rmse_truth.value);
@@ -76,7 +76,7 @@ TEST(FilterReference, AddedEstimatorIsScoredLikeAFilter) {
   // The shifted truth as an outside estimator beside the bank: its rmse_truth is the shift exactly, its NEES
   // the shift squared (P = 1), and since it is not the reference it gets no rmse_ref.
   const SineModel model;
-  FilterBank<Space, SineModel> bank(Space(), model, model, 100, 9, {"EKF"}, FilterConfig{});
+  FilterBank<Space, SineModel> bank(Space(), model, model, 100, 9, {"EKF"});
   ShiftedTruth shifted(bank.truths().state(), 0.5);
   bank.add_estimator(&shifted);
   for (long k = 0; k < 50; ++k) bank.step(k, 0.01, k + 1 == 50);

@@ -3,7 +3,7 @@
 // filter's formulas can be written out: the sine model (EKF, SOF, QLF (6.4)-(6.5), ASRE, KBL), a model with a
 // quadratic observation (the dy-driven covariance terms of EKF-DS and SOF, and QLF's cubature of h), scalar
 // polynomial drifts (POLY3, POLY4, BILIN, MIXED) and the Ornstein-Uhlenbeck model (KB).
-#include "drivers/filter_bank.hpp"
+#include "engine/filter_bank.hpp"
 #include "models/ou_model.hpp"
 #include "models/sine_model.hpp"
 
@@ -89,8 +89,8 @@ struct OneStep {
 
 /// One step of filter `name` for one member; m0, P0 the prior, dy the step's increment, m, P the result.
 template <class Model>
-OneStep one_step(const Model& model, const std::string& name, FilterConfig config = FilterConfig{}) {
-  FilterBank<Space, Model> bank(Space(), model, model, 1, 99, {name}, config);
+OneStep one_step(const Model& model, const std::string& name, const OptionValues& settings = {}) {
+  FilterBank<Space, Model> bank(Space(), model, model, 1, 99, {name}, settings);
   bank.step(0, dt, false);
   OneStep s{model.prior_mean[0], model.prior_cov(0, 0), 0.0, 0.0, 0.0};
   s.dy = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bank.truths().observations())(0, 0);
@@ -119,9 +119,9 @@ TEST(FilterSingleStep, SineEkfSofQlfAsreKbl) {
   const SineModel model;
   const double q = model.q, r = model.r;
   for (const char* name : {"EKF", "EKF-DS", "SOF", "SOF-B", "QLF", "ASRE", "KBL"}) {
-    FilterConfig config;
-    config.asre_iterations = {2};
-    const OneStep s = one_step(model, name, config);
+    OptionValues settings;
+    settings.set("asre_max_iterations", 2L);
+    const OneStep s = one_step(model, name, settings);
     const Update u = update(s.P0, 1.0, s.m0, r, s.dy);  // every filter here predicts the observation as m
     const double m = s.m0 + u.K * u.innovation, P = s.P0 - dt * u.K * s.P0;
     double a = 0.0, J = 0.0;

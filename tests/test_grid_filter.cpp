@@ -1,7 +1,7 @@
 // The grid (point-mass) filter: against the exact Kalman filter on linear models (1-D, 2-D), and against the
 // particle filter on the sine model (the acceptance test: agreement within 4 Monte Carlo standard errors of
 // the conditional mean) and the cubic oscillator.
-#include "kernels/particle_filter/particle_filter_bank.hpp"
+#include "engine/particle_filter_bank.hpp"
 #include "kernels/reference/grid_filter.hpp"
 #include "kernels/reference/kalman_bucy_reference.hpp"
 #include "models/cubic_oscillator_model.hpp"

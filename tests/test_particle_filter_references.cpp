@@ -3,7 +3,7 @@
 // is within 4 Monte Carlo standard errors of zero -- for the linear model (1-D and 2-D, against the Kalman
 // filter of the same discretization) and the Benes model (against the closed form). Power: the same runs
 // must reject a reference that is slightly wrong (a drift offset, a shifted prior).
-#include "kernels/particle_filter/particle_filter_bank.hpp"
+#include "engine/particle_filter_bank.hpp"
 #include "kernels/reference/benes_filter.hpp"
 #include "kernels/reference/kalman_bucy_reference.hpp"
 #include "models/benes_model.hpp"

@@ -1,6 +1,6 @@
 // Quantiles and histograms of the particle cloud, on the prior (a known Gaussian) and after weighting
 // (against the exact Kalman posterior); and the model -> exact reference mapping.
-#include "kernels/particle_filter/particle_snapshot.hpp"
+#include "engine/particle_snapshot.hpp"
 #include "kernels/reference/exact_reference.hpp"
 #include "models/cubic_oscillator_model.hpp"
 #include "models/sine_model.hpp"

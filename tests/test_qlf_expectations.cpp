@@ -5,7 +5,7 @@
 //   (Stein's lemma: the same filter), to 1e-9 every step; likewise on the car's Taylor model, whose P(0) is
 //   singular (the cubature takes a semidefinite square root);
 // - power: too few nodes (exact only to degree 1) is far from the closed form on both models.
-#include "drivers/filter_bank.hpp"
+#include "engine/filter_bank.hpp"
 #include "models/car_model.hpp"
 #include "models/cubic_oscillator_model.hpp"
 #include "models/sine_model.hpp"
@@ -45,8 +45,8 @@ TEST(GaussHermiteRule, IntegratesPolynomialsOfDegreeBelowTwiceTheNodesExactly) {
 }
 
 TEST(GaussHermiteRule, RefusesOrdersOutsideItsTable) {
-  EXPECT_THROW(make_gauss_hermite_rule(0), InputError);
-  EXPECT_THROW(make_gauss_hermite_rule(max_gauss_hermite_nodes + 1), InputError);
+  EXPECT_THROW(make_gauss_hermite_rule(0), std::logic_error);  // --gh-nodes is checked where it is read
+  EXPECT_THROW(make_gauss_hermite_rule(max_gauss_hermite_nodes + 1), std::logic_error);
 }
 
 TEST(GaussianExpectations, SineClosedFormMatchesCubatureAtRandomPoints) {
@@ -65,8 +65,8 @@ TEST(GaussianExpectations, SineClosedFormMatchesCubatureAtRandomPoints) {
 
 /// Two banks on the same truths (same seed), differing only in the QLF settings; calls check(a, b) every step.
 template <class Model, class Check>
-void run_side_by_side(const Model& model, const std::vector<std::string>& filters, const FilterConfig& a_config,
-                      const FilterConfig& b_config, long steps, double dt, Check&& check) {
+void run_side_by_side(const Model& model, const std::vector<std::string>& filters, const OptionValues& a_config,
+                      const OptionValues& b_config, long steps, double dt, Check&& check) {
   FilterBank<Space, Model> a(Space(), model, model, num_members, 11, filters, a_config);
   FilterBank<Space, Model> b(Space(), model, model, num_members, 11, filters, b_config);
   for (long k = 0; k < steps; ++k) {
@@ -76,11 +76,11 @@ void run_side_by_side(const Model& model, const std::vector<std::string>& filter
   }
 }
 
-FilterConfig qlf(Expectations e, int nodes) {
-  FilterConfig config;
-  config.qlf_expectations = e;
-  config.gh_nodes = nodes;
-  return config;
+OptionValues qlf(Expectations e, int nodes) {
+  OptionValues settings;
+  settings.set("qlf_expectations", std::string(e == Expectations::closed ? "closed" : "cubature"));
+  settings.set("gh_nodes", static_cast<long>(nodes));
+  return settings;
 }
 
 template <class Bank>

@@ -2,8 +2,8 @@
 // model than the filters (FilterBank's TruthModel): one step by hand, every member the same, every backend the
 // same bits, the Brownian path untouched, and a bank whose truths follow the tan car while its filters use the
 // Taylor model.
-#include "drivers/filter_bank.hpp"
-#include "drivers/simulate_ensemble.hpp"
+#include "engine/filter_bank.hpp"
+#include "engine/truth_bank.hpp"
 #include "models/car_model.hpp"
 #include "models/sine_model.hpp"
 #include "models/sine_observation_noise.hpp"
@@ -70,12 +70,12 @@ TEST(TruthModel, BankTruthsFollowTheirOwnModel) {
   CarModel tan;
   static_cast<CarBase&>(tan) = taylor;
   const double dt = 1e-3;
-  FilterBank<Space, CarTaylor3Model, CarModel> bank(Space(), tan, taylor, 3, 1, {"KBL", "POLY3"}, FilterConfig{});
+  FilterBank<Space, CarTaylor3Model, CarModel> bank(Space(), tan, taylor, 3, 1, {"KBL", "POLY3"});
   bank.step(0, dt, true);
   Space().fence();
   const auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bank.truths().state());
   EXPECT_DOUBLE_EQ(x(0, 0), std::tan(1.0) * dt);
-  FilterBank<Space, CarTaylor3Model> same(Space(), taylor, taylor, 3, 1, {"KBL", "POLY3"}, FilterConfig{});
+  FilterBank<Space, CarTaylor3Model> same(Space(), taylor, taylor, 3, 1, {"KBL", "POLY3"});
   same.step(0, dt, true);
   Space().fence();
   const auto y = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), same.truths().state());

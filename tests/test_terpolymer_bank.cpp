@@ -3,7 +3,7 @@
 // and once the prior's transient has passed (t = 2) the paper's finding holds with a margin of many standard
 // errors: "linearization leads to large deviations" (002 L1717) -- KBL's error is several times BILIN's, and
 // MIXED (BILIN's mean with KBL's covariance) is close to BILIN.
-#include "drivers/filter_run.hpp"
+#include "engine/filter_run.hpp"
 #include "models/terpolymer_model.hpp"
 
 #include <gtest/gtest.h>
@@ -20,10 +20,10 @@ TEST(TerpolymerBank, BilinearMixedAndLinearizedFiltersRunOnTenThousandMembers) {
   constexpr long num_members = 10000;
   const TimeGrid grid = make_time_grid(2.0, 0.01, 4);
   const std::vector<std::string> filters = {"BILIN", "MIXED", "KBL"};
-  FilterBank<Space, TerpolymerModel> bank(Space(), model, model, 2, 1, filters, FilterConfig{});
+  FilterBank<Space, TerpolymerModel> bank(Space(), model, model, 2, 1, filters);
   bank.with_slot("BILIN", [](const auto& slot) { EXPECT_EQ(slot.P.extent(1), 55u); });
 
-  const FilterReport report = run_filters(Space(), model, model, num_members, 20261122, grid, filters, FilterConfig{});
+  const FilterReport report = run_filters(Space(), model, model, num_members, 20261122, grid, filters);
   ASSERT_EQ(report.filters, filters);
   for (std::size_t f = 0; f < filters.size(); ++f) {
     EXPECT_EQ(report.scores[f].diverged, 0) << filters[f];

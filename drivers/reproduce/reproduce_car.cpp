@@ -1,7 +1,7 @@
 // `kushner reproduce basin-car-filter`: seed 002's automotive filter tables (L1505-1523).
 #include "drivers/filter_command_impl.hpp"
-#include "drivers/reproduce/printed_car_filter.hpp"
-#include "drivers/reproduce/prior_line_reference.hpp"
+#include "engine/printed_car_filter.hpp"
+#include "engine/prior_line_reference.hpp"
 #include "drivers/reproduce/reproduce_examples.hpp"
 #include "models/car_model.hpp"
 #include "models/sine_observation_noise.hpp"
@@ -30,7 +30,7 @@ nlohmann::json run_table(const TruthModel& truth, const CarTaylor3Model& model, 
     extra.push_back(std::make_unique<PrintedCarFilter<ExecSpace>>(space, model, 1));
     return extra;
   };
-  return run_compare_with_truth(truth, model, options, filter_config(options), grid, context, out, make_extras);
+  return run_compare_with_truth(truth, model, options, filter_option_values(options), grid, context, out, make_extras);
 }
 
 }  // namespace

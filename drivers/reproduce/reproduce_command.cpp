@@ -1,12 +1,12 @@
 // `kushner reproduce NAME --out DIR`: the seeds' worked examples run by the engine, with a table that puts the
 // paper's numbers next to ours (drivers/reproduce/reproduction_table.hpp).
-#include "drivers/backend.hpp"
+#include "engine/backend.hpp"
 #include "drivers/commands.hpp"
 #include "drivers/csv.hpp"
 #include "drivers/filter_command_impl.hpp"
 #include "drivers/reproduce/reproduce_examples.hpp"
 #include "drivers/reproduce/reproduce_options.hpp"
-#include "kernels/errors.hpp"
+#include "core/errors.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -125,7 +125,7 @@ ReproduceSettings resolve(const Example& e, const ReproduceOptions& o) {
                         "--seed: must be in 0 .. 4294967295 (got " << s.seed << ")");
   KUSHNER_INPUT_REQUIRE(std::isfinite(s.dt) && s.dt > 0.0, "--dt: must be positive (got " << s.dt << ")");
   const double steps = e.T / s.dt;
-  KUSHNER_INPUT_REQUIRE(steps >= 1.0 && steps < 4.0e9 && std::fabs(steps - std::round(steps)) <= 1e-9 * steps,
+  KUSHNER_INPUT_REQUIRE(time_grid_problem(e.T, s.dt) == TimeGridProblem::none,
                         "--dt: the horizon of " << e.name << ", T = " << e.T
                                                 << ", must be a whole number of steps (T/dt = " << steps << ")");
   return s;

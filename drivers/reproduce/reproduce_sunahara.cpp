@@ -29,7 +29,7 @@ ExampleResult run_table_example(const char* example, const Model& model, const R
   const CompareOptions options = stochastic_options(model.name, settings);
   const TimeGrid grid = make_time_grid(options.run.T, options.run.dt, options.run.output_points);
   ExampleResult result{ReproductionTable(example), "", {}, {}};
-  result.summary = run_compare_command(model, options, filter_config(options), grid, context, out);
+  result.summary = run_compare_command(model, options, filter_option_values(options), grid, context, out);
   return result;
 }
 
@@ -100,7 +100,7 @@ ExampleResult reproduce_sunahara_ex2(const ReproduceSettings& settings, const Ru
   const TimeGrid grid =
       make_time_grid(printed_options.run.T, printed_options.run.dt, printed_options.run.output_points);
   const nlohmann::json printed_summary =
-      run_compare_command(printed, printed_options, filter_config(printed_options), grid, context, printed_out);
+      run_compare_command(printed, printed_options, filter_option_values(printed_options), grid, context, printed_out);
   result.summary["printed_x0"] = {{"x0_mean", {15.0, 10.0}},
                                   {"truths_escaped", printed_summary["truths_escaped"]},
                                   {"members", settings.members},

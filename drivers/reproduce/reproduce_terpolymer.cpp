@@ -17,7 +17,7 @@ ExampleResult reproduce_basin_terpolymer(const ReproduceSettings& settings, cons
   const TimeGrid grid = make_time_grid(options.run.T, options.run.dt, options.run.output_points);
   ExampleResult result{ReproductionTable("basin-terpolymer"), "", {}, {}};
   result.summary = run_compare_with_truth(SineObservationNoise<TerpolymerModel>(model), model, options,
-                                          filter_config(options), grid, context, out);
+                                          filter_option_values(options), grid, context, out);
 
   const nlohmann::json& f = result.summary["filters"];
   const TerminalValues end = terminal_values(out, 0);

@@ -1,7 +1,7 @@
 #include "drivers/reproduce/reproduction_table.hpp"
 
 #include "drivers/csv.hpp"
-#include "kernels/errors.hpp"
+#include "core/errors.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -7,20 +7,23 @@
 // each a Kalman-Bucy run over the whole horizon with the same dy, until the estimate trajectory changes less
 // than a tolerance. Iterate i at step k needs iterate i-1 only at step k, so the iterates run as a cascade in
 // one forward pass, filter i reading filter i-1's current estimate: the same numbers as sweeping the horizon
-// once per iteration, with no stored trajectories. (With this explicit step, iterate i equals the causal
-// state-dependent-coefficient filter on the first i + 1 steps; /work/notes/filters.md, ASRE.)
-// One bank pass with `max_iterations` iterates records, per member and iterate, the largest change
-// max_t |m^[i](t) - m^[i-1](t)|_inf (`change`); drivers/filter_run.hpp picks each member's first iterate
-// below the tolerance and runs the bank again reporting that iterate.
+// once per iteration, with no stored trajectories. (With this explicit step iterate i linearizes at iterate
+// i - 1's estimate of the same step, so on the first i + 1 steps it equals the causal state-dependent-coefficient
+// filter that linearizes at its own estimate: tests/test_asre_filter.cpp checks it.)
+// The pre-pass (prepare) runs the truths with ASRE alone, recording per member and iterate the largest change
+// max_t |m^[i](t) - m^[i-1](t)|_inf (`change`), and picks each member's first iterate below the tolerance;
+// the run then reports that iterate.
 #include "kernels/bank.hpp"
-#include "kernels/errors.hpp"
-#include "kernels/filters/filter_config.hpp"
+#include "core/errors.hpp"
+#include "kernels/filters/filter_protocol.hpp"
 #include "kernels/filters/jacobian_linearization.hpp"
-#include "kernels/filters/model_traits.hpp"
+#include "models/model_traits.hpp"
 
 #include <Kokkos_Core.hpp>
 
 #include <algorithm>
+#include <cmath>
+#include <vector>
 
 namespace kushner {
 
@@ -39,29 +42,45 @@ struct AsreFilter {
       "approximating sequence of Riccati equations, Cimen-Banks (iterated over the horizon)";
   static constexpr const char* unsupported = asre_unsupported<Model>();
 
+  /// What the pre-pass found, for summary.json (host only; `prepared` is false without a pre-pass).
+  struct Iterations {
+    bool prepared = false;
+    double mean = 0.0;
+    int min = 0, max = 0;
+    long not_converged = 0;  // members that reached max_iterations without meeting the tolerance
+    long diverged = 0;       // members whose iterates (or truth) did not stay finite: left out above
+    double tolerance = 0.0;
+    int max_iterations = 0;
+  };
+
   Vec<n> prior_mean;
   Kokkos::View<int*, MemSpace> iterations;                      // (member): the iterate reported
   Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace> m;      // (member, i, iterate)
   Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace> P;      // (member, packed k, iterate)
   Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> change;  // (member, iterate): max_t |m^[i] - m^[i-1]|_inf
+  Iterations summary;
 
-  static AsreFilter create(const FilterConfig& config, const Model& model, long members) {
-    KUSHNER_INPUT_REQUIRE(config.asre_max_iterations >= 1 && config.asre_max_iterations <= 1000,
-                          "--asre-max-iterations: must be in 1 .. 1000 (got " << config.asre_max_iterations << ")");
-    KUSHNER_REQUIRE(
-        config.asre_iterations.empty() || static_cast<long>(config.asre_iterations.size()) == members,
-        "asre_iterations has " << config.asre_iterations.size() << " entries for " << members << " members");
+  static std::vector<OptionSpec> options() {
+    return {OptionSpec::positive_real("asre_tolerance", 1e-6,
+                                      "ASRE stops iterating when max_t |m^[i](t) - m^[i-1](t)| is below this"),
+            OptionSpec::integer("asre_max_iterations", 30, 1, 1000, "ASRE iterations at most")};
+  }
+
+  /// Every member iterated asre_max_iterations times (a run without the pre-pass: tests, benchmarks).
+  static AsreFilter create(const OptionValues& options, const Model& model, long members) {
+    return with_iterations(model, std::vector<int>(members, static_cast<int>(options.integer("asre_max_iterations"))));
+  }
+
+  /// Member i iterated iterations[i] times.
+  static AsreFilter with_iterations(const Model& model, const std::vector<int>& per_member) {
+    const long members = static_cast<long>(per_member.size());
     AsreFilter f;
     f.prior_mean = model.prior_mean;
     f.iterations = Kokkos::View<int*, MemSpace>("kushner::asre_iterations", members);
     auto iterations_host = Kokkos::create_mirror_view(f.iterations);
-    for (long member = 0; member < members; ++member)
-      iterations_host(member) =
-          config.asre_iterations.empty() ? config.asre_max_iterations : config.asre_iterations[member];
+    for (long member = 0; member < members; ++member) iterations_host(member) = per_member[member];
     Kokkos::deep_copy(f.iterations, iterations_host);
-    const int iterates = 1 + (config.asre_iterations.empty()
-                                  ? config.asre_max_iterations
-                                  : *std::max_element(config.asre_iterations.begin(), config.asre_iterations.end()));
+    const int iterates = 1 + (members > 0 ? *std::max_element(per_member.begin(), per_member.end()) : 0);
     f.m = decltype(f.m)(Kokkos::view_alloc(Kokkos::WithoutInitializing, "kushner::asre_m"), members, n, iterates);
     f.P = decltype(f.P)(Kokkos::view_alloc(Kokkos::WithoutInitializing, "kushner::asre_P"), members, packed_size(n),
                         iterates);
@@ -77,6 +96,76 @@ struct AsreFilter {
     Kokkos::deep_copy(f.m, m_host);
     Kokkos::deep_copy(f.P, P_host);
     return f;
+  }
+
+  /// The pre-pass: per member, the first iterate i >= 1 with max_t |m^[i] - m^[i-1]| < tolerance (else
+  /// asre_max_iterations). Iterates do not depend on how many follow them, so it runs the truths with ASRE
+  /// alone twice: every member iterated `first_round` times, then only the members still unconverged up to the
+  /// maximum (the others iterate 0 times there). run_alone(filter) runs that pass and returns, per member,
+  /// whether its filter and truth stayed finite.
+  static constexpr int prepass_passes = 2;
+  template <class RunAlone>
+  static AsreFilter prepare(const OptionValues& options, const Model& model, long members, RunAlone&& run_alone) {
+    constexpr int first_round = 10;  // most members of the seed models converge within it at tolerance 1e-6
+    const double tolerance = options.real("asre_tolerance");
+    const int max_iterations = static_cast<int>(options.integer("asre_max_iterations"));
+    std::vector<int> first(members, 0);
+    std::vector<char> diverged(members, 0);
+    const auto pass = [&](const std::vector<int>& iterations) {
+      const AsreFilter f = with_iterations(model, iterations);
+      const std::vector<char> ok = run_alone(f);
+      const auto change_host = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), f.change);
+      for (long member = 0; member < members; ++member) {
+        if (!ok[member]) diverged[member] = 1;
+        for (int i = 1; i <= iterations[member] && !diverged[member]; ++i)
+          if (change_host(member, i) < tolerance) {
+            first[member] = i;
+            break;
+          }
+      }
+    };
+    pass(std::vector<int>(members, std::min(first_round, max_iterations)));
+    std::vector<int> rest(members, 0);
+    bool any = false;
+    for (long member = 0; member < members; ++member)
+      if (first[member] == 0 && !diverged[member] && max_iterations > first_round)
+        rest[member] = max_iterations, any = true;
+    if (any) pass(rest);
+
+    std::vector<int> per_member(members);
+    Iterations s;
+    s.prepared = true;
+    s.tolerance = tolerance;
+    s.max_iterations = max_iterations;
+    s.min = max_iterations;
+    double sum = 0.0;
+    for (long member = 0; member < members; ++member) {
+      per_member[member] = first[member] > 0 ? first[member] : max_iterations;
+      if (diverged[member]) {
+        ++s.diverged;
+        continue;
+      }
+      if (first[member] == 0) ++s.not_converged;
+      s.min = std::min(s.min, per_member[member]);
+      s.max = std::max(s.max, per_member[member]);
+      sum += per_member[member];
+    }
+    s.mean = members > s.diverged ? sum / (members - s.diverged) : std::nan("");
+    AsreFilter f = with_iterations(model, per_member);
+    f.summary = s;
+    return f;
+  }
+
+  /// summary.json: "iterations" {mean, min, max, not_converged, diverged, tolerance, max_iterations}.
+  Fields summary_fields() const {
+    if (!summary.prepared) return {};
+    return {{"iterations.mean", summary.mean},
+            {"iterations.min", static_cast<long>(summary.min)},
+            {"iterations.max", static_cast<long>(summary.max)},
+            {"iterations.not_converged", summary.not_converged},
+            {"iterations.diverged", summary.diverged},
+            {"iterations.tolerance", summary.tolerance},
+            {"iterations.max_iterations", static_cast<long>(summary.max_iterations)}};
   }
 
   KOKKOS_INLINE_FUNCTION Status step(const Model& model, int member, const StepInput<p>& in, Vec<n>& m_out,

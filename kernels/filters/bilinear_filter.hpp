@@ -3,9 +3,9 @@
 // observation (seed 002 ACC03 (13)-(14), components (16)-(17)):
 //   dm_k = (a0_k + sum_i a1_ki m_i + sum_ij a2_kij (m_i m_j + P_ij)) dt + [P A^T V^{-1}(dy - A m dt)]_k,
 //   dP   = (J P + P J^T + b b^T - P A^T V^{-1} A P) dt,   J = a1 + 2 a2 m  (a2 symmetric in i, j).
-#include "kernels/filters/filter_config.hpp"
+#include "kernels/filters/filter_protocol.hpp"
 #include "kernels/filters/jacobian_linearization.hpp"
-#include "kernels/filters/model_traits.hpp"
+#include "models/model_traits.hpp"
 #include "kernels/filters/polynomial_moments.hpp"
 
 namespace kushner {
@@ -24,7 +24,11 @@ struct BilinearFilter {
   static constexpr const char* description = "Basin's optimal filter for a bilinear drift (coefficient tensor a2)";
   static constexpr const char* unsupported = bilinear_filter_unsupported<Model>();
 
-  static BilinearFilter create(const FilterConfig&, const Model&, long) { return {}; }
+  static const char* unsupported_by(const DriftFacts& f) {
+    return f.degree > 2 ? "drift is not bilinear (degree above 2)" : nullptr;
+  }
+
+  static BilinearFilter create(const OptionValues&, const Model&, long) { return {}; }
 
   KOKKOS_INLINE_FUNCTION Status step(const Model& model, int, const StepInput<p>& in, Vec<n>& m, Mat<n, n>& P) const {
     static_assert(unsupported == nullptr,

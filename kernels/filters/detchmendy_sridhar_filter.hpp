@@ -4,7 +4,7 @@
 //   dP = (F P + P F^T + W - P H^T V^{-1} H P) dt + 1/2 sum_l P Hess h_l(m) P [V^{-1}(dy - h(m) dt)]_l.
 // The factor 1/2 is the printed one (an invariant-imbedding derivation gives 1; /work/notes/filters.md 1.3).
 // With a linear observation the term vanishes and EKF-DS is the EKF.
-#include "kernels/filters/filter_config.hpp"
+#include "kernels/filters/filter_protocol.hpp"
 #include "kernels/filters/jacobian_linearization.hpp"
 #include "kernels/filters/second_order_terms.hpp"
 
@@ -18,7 +18,7 @@ struct DetchmendySridharFilter {
       "first-order filter, Detchmendy-Sridhar (row [13]: extra h'' covariance term)";
   static constexpr const char* unsupported = nullptr;
 
-  static DetchmendySridharFilter create(const FilterConfig&, const Model&, long) { return {}; }
+  static DetchmendySridharFilter create(const OptionValues&, const Model&, long) { return {}; }
 
   KOKKOS_INLINE_FUNCTION Status step(const Model& model, int, const StepInput<p>& in, Vec<n>& m, Mat<n, n>& P) const {
     const Vec<n> m0 = m;

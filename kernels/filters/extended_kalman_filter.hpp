@@ -2,7 +2,7 @@
 // EKF: the first-order filter of Cox, seed 000 Tables 1-2 row [14] (the brief's "[13]": the reference list,
 // 000 L470-471, has [13] = Detchmendy-Sridhar, [14] = Cox; see /work/notes/filters.md section 0.3):
 //   dm = f(m) dt + P H(m)^T V^{-1} (dy - h(m) dt),   dP = (F(m) P + P F(m)^T + W - P H^T V^{-1} H P) dt.
-#include "kernels/filters/filter_config.hpp"
+#include "kernels/filters/filter_protocol.hpp"
 #include "kernels/filters/jacobian_linearization.hpp"
 
 namespace kushner {
@@ -14,7 +14,7 @@ struct ExtendedKalmanFilter {
   static constexpr const char* description = "first-order filter (Cox; Sunahara 1968 Table 1-2 row [14])";
   static constexpr const char* unsupported = nullptr;  // every continuous-time model has its Jacobians
 
-  static ExtendedKalmanFilter create(const FilterConfig&, const Model&, long) { return {}; }
+  static ExtendedKalmanFilter create(const OptionValues&, const Model&, long) { return {}; }
 
   KOKKOS_INLINE_FUNCTION Status step(const Model& model, int, const StepInput<p>& in, Vec<n>& m, Mat<n, n>& P) const {
     Vec<p> weighted_innovation;

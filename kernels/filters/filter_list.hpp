@@ -1,12 +1,16 @@
 #pragma once
-// The filters of the bank, in the order runs report them, and which of them a model supports. A filter that
-// needs something a model lacks (a polynomial drift, a factorization, Gaussian expectations) says why in its
-// `unsupported` string; the bank instantiates only the supported ones (so no filter ever runs on a model it
-// cannot handle, and each filter's step static_asserts its own requirements).
+// The filters of the bank, in the order runs report them: adding a filter is its header and one entry in
+// AllFilters. Everything else (the command line and its options, `kushner filters`, the summary, the tests that
+// loop over filters) is generated from this list and each filter's declarations
+// (kernels/filters/filter_protocol.hpp). A filter that needs something a model lacks (a polynomial drift, a
+// factorization, Gaussian expectations) says why in its `unsupported` string; the bank instantiates only the
+// supported ones (so no filter ever runs on a model it cannot handle, and each filter's step static_asserts its
+// own requirements).
 #include "kernels/filters/asre_filter.hpp"
 #include "kernels/filters/bilinear_filter.hpp"
 #include "kernels/filters/detchmendy_sridhar_filter.hpp"
 #include "kernels/filters/extended_kalman_filter.hpp"
+#include "kernels/filters/filter_protocol.hpp"
 #include "kernels/filters/kalman_bucy_filter.hpp"
 #include "kernels/filters/linearized_kalman_bucy_filter.hpp"
 #include "kernels/filters/mixed_filter.hpp"
@@ -14,6 +18,10 @@
 #include "kernels/filters/quasi_linear_filter.hpp"
 #include "kernels/filters/second_order_filter.hpp"
 
+#include "models/linear_model.hpp"
+
+#include <algorithm>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -58,17 +66,58 @@ void for_each_filter_type(F&& f) {
 struct FilterSupport {
   std::string name, description;
   const char* unsupported;  // nullptr: supported
+  std::vector<OptionSpec> options;
 };
 
-/// Every filter, in report order, with whether (and why not) it supports Model.
+/// Every filter, in report order, with whether (and why not) it can run `model`: its type, and for a model
+/// known only at run time (a --model-file polynomial) its coefficients.
 template <class Model>
-std::vector<FilterSupport> filter_support() {
+std::vector<FilterSupport> filter_support(const Model& model) {
   std::vector<FilterSupport> list;
   for_each_filter_type<Model, Kokkos::HostSpace>([&](auto* tag) {
     using Filter = std::remove_pointer_t<decltype(tag)>;
-    list.push_back({Filter::name, Filter::description, Filter::unsupported});
+    list.push_back({Filter::name, Filter::description, filter_unsupported<Filter>(model), filter_options<Filter>()});
   });
   return list;
+}
+
+/// The names of the filters that can run `model`, in report order.
+template <class Model>
+std::vector<std::string> supported_filters(const Model& model) {
+  std::vector<std::string> names;
+  for (const auto& f : filter_support(model))
+    if (f.unsupported == nullptr) names.push_back(f.name);
+  return names;
+}
+
+/// Every filter name, in report order (names do not depend on the model).
+inline std::vector<std::string> all_filter_names() {
+  std::vector<std::string> names;
+  for_each_filter_type<LinearModel<1>, Kokkos::HostSpace>([&](auto* tag) {
+    names.push_back(std::remove_pointer_t<decltype(tag)>::name);
+  });
+  return names;
+}
+
+/// Every filter's options, in report order (they do not depend on the model).
+inline std::vector<OptionSpec> all_filter_options() {
+  std::vector<OptionSpec> options;
+  for_each_filter_type<LinearModel<1>, Kokkos::HostSpace>([&](auto* tag) {
+    for (auto& o : filter_options<std::remove_pointer_t<decltype(tag)>>()) options.push_back(std::move(o));
+  });
+  return options;
+}
+
+/// The first setting among the filters `names` that Model cannot use.
+template <class Model>
+std::optional<OptionProblem> filter_option_problem(const std::vector<std::string>& names, const OptionValues& values) {
+  std::optional<OptionProblem> problem;
+  for_each_filter_type<Model, Kokkos::HostSpace>([&](auto* tag) {
+    using Filter = std::remove_pointer_t<decltype(tag)>;
+    if (problem || std::find(names.begin(), names.end(), Filter::name) == names.end()) return;
+    if constexpr (Filter::unsupported == nullptr) problem = check_filter_options<Filter>(values);
+  });
+  return problem;
 }
 
 }  // namespace kushner

@@ -4,8 +4,8 @@
 // Integer counts are order-independent, so a parallel_reduce keeps them deterministic.
 #include "kernels/bank.hpp"
 #include "kernels/filters/filter_slot.hpp"
-#include "kernels/math.hpp"
-#include "kernels/status.hpp"
+#include "core/math.hpp"
+#include "core/status.hpp"
 
 #include <Kokkos_Core.hpp>
 

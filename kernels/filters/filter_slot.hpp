@@ -4,7 +4,7 @@
 // advance() is what the bank's fused step kernel does for one member and one filter.
 #include "kernels/bank.hpp"
 #include "kernels/filters/filter_step.hpp"
-#include "kernels/status.hpp"
+#include "core/status.hpp"
 
 #include <Kokkos_Core.hpp>
 

@@ -13,13 +13,13 @@
 // semidefinite (the update is a Schur complement, the prediction a congruence plus W dt), so a singular P(0)
 // (seed 002's car example) stays a valid covariance; only filters whose covariance equation has a dy term
 // (SOF, EKF-DS) can lose definiteness, which the bank reports as divergence.
-#include "kernels/linear_algebra.hpp"
-#include "kernels/small_matrix.hpp"
-#include "kernels/status.hpp"
+#include "core/linear_algebra.hpp"
+#include "core/small_matrix.hpp"
+#include "core/status.hpp"
 
 namespace kushner {
 
-/// Pivots within this fraction of the largest variance count as zero (kernels/linear_algebra.hpp).
+/// Pivots within this fraction of the largest variance count as zero (core/linear_algebra.hpp).
 constexpr double covariance_tolerance = 1e-10;
 
 /// What one step of one member gives every filter.

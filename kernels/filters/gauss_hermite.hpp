@@ -2,7 +2,7 @@
 // Gauss-Hermite quadrature for the standard normal: sum_q w_q g(xi_q) = E[g(Z)], Z ~ N(0, 1), exact for
 // polynomials g of degree <= 2 K - 1 with K nodes. The rule is computed on the host once per run and copied
 // into the kernels by value; tensor products of it integrate over N(0, I) in dimension <= 3.
-#include "kernels/errors.hpp"
+#include "core/errors.hpp"
 
 #include <cmath>
 
@@ -21,8 +21,7 @@ struct GaussHermiteRule {
 /// starting values of Numerical Recipes' `gauher` (weight e^{-x^2}), then rescaled: xi = sqrt(2) x,
 /// w = w_phys / sqrt(pi). Host only.
 inline GaussHermiteRule make_gauss_hermite_rule(int order) {
-  KUSHNER_INPUT_REQUIRE(order >= 1 && order <= max_gauss_hermite_nodes,
-                        "--gh-nodes: must be in 1 .. " << max_gauss_hermite_nodes << " (got " << order << ")");
+  KUSHNER_REQUIRE(order >= 1 && order <= max_gauss_hermite_nodes, "order " << order);
   GaussHermiteRule rule;
   rule.order = order;
   const int n = order;

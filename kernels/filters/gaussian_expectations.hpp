@@ -9,7 +9,7 @@
 //                state dimension <= 3.
 #include "kernels/filters/filter_step.hpp"
 #include "kernels/filters/gauss_hermite.hpp"
-#include "kernels/filters/model_traits.hpp"
+#include "models/model_traits.hpp"
 #include "kernels/filters/polynomial_moments.hpp"
 
 namespace kushner {

@@ -2,9 +2,9 @@
 // KB: the Kalman-Bucy filter of a linear model dx = (a0 + A x) dt + G dw, dy = (c0 + C x) dt + R dv
 // (seed 002 filter paper section 2, ACC03 (4)-(5); seed 004 (2.3)-(2.4)):
 //   dm = (a0 + A m) dt + P C^T V^{-1} (dy - (c0 + C m) dt),   dP = (A P + P A^T + G G^T - P C^T V^{-1} C P) dt.
-#include "kernels/filters/filter_config.hpp"
+#include "kernels/filters/filter_protocol.hpp"
 #include "kernels/filters/filter_step.hpp"
-#include "kernels/filters/model_traits.hpp"
+#include "models/model_traits.hpp"
 
 namespace kushner {
 
@@ -15,7 +15,11 @@ struct KalmanBucyFilter {
   static constexpr const char* description = "Kalman-Bucy (linear models)";
   static constexpr const char* unsupported = ModelTraits<Model>::linear ? nullptr : "model is not linear";
 
-  static KalmanBucyFilter create(const FilterConfig&, const Model&, long) { return {}; }
+  static const char* unsupported_by(const DriftFacts& f) {
+    return f.degree > 1 ? "drift is not linear (the file has terms of degree 2 or more)" : nullptr;
+  }
+
+  static KalmanBucyFilter create(const OptionValues&, const Model&, long) { return {}; }
 
   KOKKOS_INLINE_FUNCTION Status step(const Model& model, int, const StepInput<p>& in, Vec<n>& m, Mat<n, n>& P) const {
     static_assert(ModelTraits<Model>::linear, "KalmanBucyFilter: Model must define linear_form(t)");

@@ -3,7 +3,7 @@
 // (20)-(21): "only the linear terms and innovations processes"):
 //   a0 = f(t, 0), F0 = df/dx(t, 0), c0 = h(t, 0), H0 = dh/dx(t, 0), W0 = G(t, 0) G(t, 0)^T,
 //   dm = (a0 + F0 m) dt + P H0^T V^{-1} (dy - (c0 + H0 m) dt),   dP = (F0 P + P F0^T + W0 - P H0^T V^{-1} H0 P) dt.
-#include "kernels/filters/filter_config.hpp"
+#include "kernels/filters/filter_protocol.hpp"
 #include "kernels/filters/jacobian_linearization.hpp"
 
 namespace kushner {
@@ -32,7 +32,7 @@ struct LinearizedKalmanBucyFilter {
   static constexpr const char* description = "Kalman-Bucy on the model linearized at the origin";
   static constexpr const char* unsupported = nullptr;
 
-  static LinearizedKalmanBucyFilter create(const FilterConfig&, const Model&, long) { return {}; }
+  static LinearizedKalmanBucyFilter create(const OptionValues&, const Model&, long) { return {}; }
 
   KOKKOS_INLINE_FUNCTION Status step(const Model& model, int, const StepInput<p>& in, Vec<n>& m, Mat<n, n>& P) const {
     Vec<p> weighted_innovation;

@@ -5,9 +5,9 @@
 //   dP = (F0 P + P F0^T + W0 - P H0^T V^{-1} H0 P) dt       the KBL covariance (origin linearization).
 // The paper uses it for the bilinear terpolymer model; for componentwise polynomials (cubic oscillator, the
 // car's Taylor model) we take the POLY3/POLY4 mean, the same Gaussian closure (/work/notes/filters.md 1.9).
-#include "kernels/filters/filter_config.hpp"
+#include "kernels/filters/filter_protocol.hpp"
 #include "kernels/filters/linearized_kalman_bucy_filter.hpp"
-#include "kernels/filters/model_traits.hpp"
+#include "models/model_traits.hpp"
 #include "kernels/filters/polynomial_moments.hpp"
 
 namespace kushner {
@@ -28,7 +28,7 @@ struct MixedFilter {
       "Basin's mixed filter: polynomial-filter mean, linearized Kalman-Bucy covariance";
   static constexpr const char* unsupported = mixed_filter_unsupported<Model>();
 
-  static MixedFilter create(const FilterConfig&, const Model&, long) { return {}; }
+  static MixedFilter create(const OptionValues&, const Model&, long) { return {}; }
 
   KOKKOS_INLINE_FUNCTION Status step(const Model& model, int, const StepInput<p>& in, Vec<n>& m, Mat<n, n>& P) const {
     static_assert(unsupported == nullptr, "MixedFilter: Model must have a polynomial drift and a linear observation");

@@ -7,9 +7,9 @@
 //   E_N[f] = a0 + a1 m + a2 (p + m^2) + a3 (3 p m + m^3) [+ a4 (3 p^2 + 6 p m^2 + m^4)],
 //   J = a1 + 2 a2 diag(m) + 3 a3 diag(p + m^2) [+ 4 a4 diag(3 p m + m^3)],  p = diag(P).
 // Lower-degree drifts are the special cases with vanishing coefficients (002 L1428).
-#include "kernels/filters/filter_config.hpp"
+#include "kernels/filters/filter_protocol.hpp"
 #include "kernels/filters/jacobian_linearization.hpp"
-#include "kernels/filters/model_traits.hpp"
+#include "models/model_traits.hpp"
 #include "kernels/filters/polynomial_moments.hpp"
 
 namespace kushner {
@@ -20,10 +20,18 @@ constexpr const char* polynomial_filter_unsupported() {
   if (!T::power_polynomial)
     return T::quadratic_polynomial ? "drift has cross terms x_i x_j, not componentwise powers (BILIN handles them)"
                                    : "drift is not polynomial";
-  // A run-time polynomial's degree is checked per file (filter_unsupported); its type allows degree 4.
+  // A run-time polynomial's degree is checked on its coefficients (unsupported_by); its type allows degree 4.
   if (T::power_degree() > Degree && !T::runtime_checked)
     return Degree == 3 ? "drift has degree above 3" : "drift has degree above 4";
   if (!T::linear_observation) return "observation is not linear";
+  return nullptr;
+}
+
+/// What a run-time polynomial's coefficients must satisfy (its type allows any degree up to 4).
+template <int Degree>
+const char* polynomial_filter_unsupported_by(const DriftFacts& f) {
+  if (f.cross_terms) return "drift has cross terms (monomials of two or more variables), not componentwise powers";
+  if (f.degree > Degree) return Degree == 3 ? "drift has degree above 3" : "drift has degree above 4";
   return nullptr;
 }
 
@@ -52,7 +60,9 @@ struct Polynomial3Filter {
   static constexpr const char* description = "Basin's optimal filter for a third-degree polynomial drift";
   static constexpr const char* unsupported = polynomial_filter_unsupported<Model, 3>();
 
-  static Polynomial3Filter create(const FilterConfig&, const Model&, long) { return {}; }
+  static const char* unsupported_by(const DriftFacts& f) { return polynomial_filter_unsupported_by<3>(f); }
+
+  static Polynomial3Filter create(const OptionValues&, const Model&, long) { return {}; }
 
   KOKKOS_INLINE_FUNCTION Status step(const Model& model, int, const StepInput<p>& in, Vec<n>& m, Mat<n, n>& P) const {
     return PolynomialStep<Model, 3>::step(model, in, m, P);
@@ -66,7 +76,9 @@ struct Polynomial4Filter {
   static constexpr const char* description = "Basin's optimal filter for a fourth-degree polynomial drift";
   static constexpr const char* unsupported = polynomial_filter_unsupported<Model, 4>();
 
-  static Polynomial4Filter create(const FilterConfig&, const Model&, long) { return {}; }
+  static const char* unsupported_by(const DriftFacts& f) { return polynomial_filter_unsupported_by<4>(f); }
+
+  static Polynomial4Filter create(const OptionValues&, const Model&, long) { return {}; }
 
   KOKKOS_INLINE_FUNCTION Status step(const Model& model, int, const StepInput<p>& in, Vec<n>& m, Mat<n, n>& P) const {
     return PolynomialStep<Model, 4>::step(model, in, m, P);

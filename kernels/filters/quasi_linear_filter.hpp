@@ -3,12 +3,23 @@
 //   dm = a dt + P H2^T V^{-1} (dy - h1 dt),   dP = (B P + P B^T + W - P H2^T V^{-1} H2 P) dt,
 // with a, B, h1, H2 the Gaussian expectations of kernels/filters/gaussian_expectations.hpp and W = G(m) G(m)^T
 // (the paper's noise is state-independent, as in every model here).
-#include "kernels/errors.hpp"
-#include "kernels/filters/filter_config.hpp"
+#include "core/errors.hpp"
+#include "kernels/filters/gauss_hermite.hpp"
+#include "kernels/filters/filter_protocol.hpp"
 #include "kernels/filters/gaussian_expectations.hpp"
 #include "kernels/filters/jacobian_linearization.hpp"
 
+#include <optional>
+#include <string>
+#include <vector>
+
 namespace kushner {
+
+/// How QLF obtains its Gaussian expectations E_N[f], E_N[grad f], E_N[h], E_N[grad h].
+enum class Expectations {
+  closed,    // the model's formulas (seed 000 (6.4)-(6.5), (6.14)) or exact moments of a polynomial drift
+  cubature,  // tensor-product Gauss-Hermite, any model of state dimension <= 3
+};
 
 template <class Model>
 constexpr const char* qlf_unsupported() {
@@ -17,21 +28,6 @@ constexpr const char* qlf_unsupported() {
   if (!T::closed_form_expectations && Model::state_dim > max_cubature_dim)
     return "no closed-form Gaussian expectations, and tensor Gauss-Hermite cubature is limited to state_dim <= 3";
   return nullptr;
-}
-
-/// The expectation method a run uses: `automatic` resolved, requests a model cannot meet refused (InputError).
-template <class Model>
-Expectations resolve_qlf_expectations(Expectations requested) {
-  constexpr bool closed = ModelTraits<Model>::closed_form_expectations;
-  constexpr bool cubature = Model::state_dim <= max_cubature_dim;
-  if (requested == Expectations::automatic) return closed ? Expectations::closed : Expectations::cubature;
-  KUSHNER_INPUT_REQUIRE(
-      requested != Expectations::closed || closed,
-      "--qlf-expectations: model '" << Model::name << "' has no closed-form Gaussian expectations (use cubature)");
-  KUSHNER_INPUT_REQUIRE(requested != Expectations::cubature || cubature,
-                        "--qlf-expectations: cubature is limited to state_dim <= "
-                            << max_cubature_dim << " (model '" << Model::name << "' has " << Model::state_dim << ")");
-  return requested;
 }
 
 template <class Model, class MemSpace>
@@ -47,11 +43,48 @@ struct QuasiLinearFilter {
   Expectations expectations = Expectations::closed;
   GaussHermiteRule rule;
 
-  static QuasiLinearFilter create(const FilterConfig& config, const Model&, long) {
+  static std::vector<OptionSpec> options() {
+    return {OptionSpec::choice("qlf_expectations", "auto", {"auto", "closed", "cubature"},
+                               "QLF's Gaussian expectations: closed (the model's formulas), cubature (Gauss-Hermite), "
+                               "or auto (closed where the model has them)"),
+            OptionSpec::integer("gh_nodes", 8, 1, max_gauss_hermite_nodes,
+                                "Gauss-Hermite nodes per axis for QLF cubature")};
+  }
+
+  /// A requested method this model does not have.
+  static std::optional<OptionProblem> check(const OptionValues& options) {
+    const std::string& requested = options.word("qlf_expectations");
+    if (requested == "closed" && !has_closed)
+      return OptionProblem{"qlf_expectations", std::string("model '") + Model::name +
+                                                   "' has no closed-form Gaussian expectations (use cubature)"};
+    if (requested == "cubature" && !has_cubature)
+      return OptionProblem{"qlf_expectations", "cubature is limited to state_dim <= " +
+                                                   std::to_string(max_cubature_dim) + " (model '" + Model::name +
+                                                   "' has " + std::to_string(n) + ")"};
+    return std::nullopt;
+  }
+
+  /// The method a run uses: `auto` is closed form where the model has it, else cubature.
+  static Expectations resolve(const std::string& requested) {
+    if (requested == "closed") return Expectations::closed;
+    if (requested == "cubature") return Expectations::cubature;
+    return has_closed ? Expectations::closed : Expectations::cubature;
+  }
+
+  static QuasiLinearFilter create(const OptionValues& options, const Model&, long) {
+    const std::optional<OptionProblem> problem = check(options);
+    KUSHNER_REQUIRE(!problem, problem->message);
     QuasiLinearFilter f;
-    f.expectations = resolve_qlf_expectations<Model>(config.qlf_expectations);
-    if (f.expectations == Expectations::cubature) f.rule = make_gauss_hermite_rule(config.gh_nodes);
+    f.expectations = resolve(options.word("qlf_expectations"));
+    if (f.expectations == Expectations::cubature)
+      f.rule = make_gauss_hermite_rule(static_cast<int>(options.integer("gh_nodes")));
     return f;
+  }
+
+  /// summary.json: the method used ("closed", "cubature") and, for cubature, the nodes per axis.
+  Fields summary_fields() const {
+    if (expectations == Expectations::closed) return {{"expectations", std::string("closed")}};
+    return {{"expectations", std::string("cubature")}, {"gh_nodes", static_cast<long>(rule.order)}};
   }
 
   KOKKOS_INLINE_FUNCTION Status step(const Model& model, int, const StepInput<p>& in, Vec<n>& m, Mat<n, n>& P) const {

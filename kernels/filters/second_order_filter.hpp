@@ -4,7 +4,7 @@
 //   dm = f_bar dt + P H^T V^{-1} (dy - h_bar dt),
 //   dP = (F P + P F^T + W - P H^T V^{-1} H P) dt + sum_l P Hess h_l P [V^{-1}(dy - h_bar dt)]_l.
 // SOF-B: Schwartz-Bass, row [12]: the same mean, the covariance without the dy term.
-#include "kernels/filters/filter_config.hpp"
+#include "kernels/filters/filter_protocol.hpp"
 #include "kernels/filters/jacobian_linearization.hpp"
 #include "kernels/filters/second_order_terms.hpp"
 
@@ -37,7 +37,7 @@ struct SecondOrderFilter {
       "second-order filter, Schwartz (row [9], Hessian terms in mean and covariance)";
   static constexpr const char* unsupported = nullptr;  // every continuous-time model has its Hessians
 
-  static SecondOrderFilter create(const FilterConfig&, const Model&, long) { return {}; }
+  static SecondOrderFilter create(const OptionValues&, const Model&, long) { return {}; }
 
   KOKKOS_INLINE_FUNCTION Status step(const Model& model, int, const StepInput<p>& in, Vec<n>& m, Mat<n, n>& P) const {
     return SecondOrderStep<Model, true>::step(model, in, m, P);
@@ -51,7 +51,7 @@ struct SchwartzBassFilter {
   static constexpr const char* description = "second-order filter, Schwartz-Bass (row [12], no dy covariance term)";
   static constexpr const char* unsupported = nullptr;
 
-  static SchwartzBassFilter create(const FilterConfig&, const Model&, long) { return {}; }
+  static SchwartzBassFilter create(const OptionValues&, const Model&, long) { return {}; }
 
   KOKKOS_INLINE_FUNCTION Status step(const Model& model, int, const StepInput<p>& in, Vec<n>& m, Mat<n, n>& P) const {
     return SecondOrderStep<Model, false>::step(model, in, m, P);

@@ -17,8 +17,8 @@
 // order, same expressions), so the indices are the same as the one-team path's on every backend; the test
 // ChunkedSystematic.MatchesTheTeamPathAndMovesTheParticles (tests/test_resampling.cpp) checks it.
 #include "kernels/bank.hpp"
-#include "kernels/errors.hpp"
-#include "kernels/math.hpp"
+#include "core/errors.hpp"
+#include "core/math.hpp"
 #include "kernels/particle_filter/blocked_scan.hpp"
 #include "kernels/particle_filter/resampling.hpp"
 

@@ -1,6 +1,6 @@
 #pragma once
 // What the particle filter asks of a model beyond the usual drift/diffusion/observation functions.
-#include "kernels/small_matrix.hpp"
+#include "core/small_matrix.hpp"
 
 #include <type_traits>
 #include <utility>

@@ -4,7 +4,7 @@
 // ESS = (sum w)^2 / sum w^2 (Kong, Liu & Wong 1994), the log-normalizer, and the decision to resample.
 #include "kernels/bank.hpp"
 #include "kernels/particle_filter/weighted_moments.hpp"
-#include "kernels/status.hpp"
+#include "core/status.hpp"
 
 #include <Kokkos_Core.hpp>
 

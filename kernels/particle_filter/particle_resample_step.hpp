@@ -4,7 +4,7 @@
 // then cumulative weights (resample_member), then the particles are gathered by ancestor into a scratch
 // bank and copied back, and the weights reset to equal.
 #include "kernels/bank.hpp"
-#include "kernels/math.hpp"
+#include "core/math.hpp"
 #include "kernels/particle_filter/resampling.hpp"
 
 #include <Kokkos_Core.hpp>

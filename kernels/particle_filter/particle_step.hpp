@@ -10,14 +10,14 @@
 // team reduces its chunk in shared memory. Both call the same per-particle physics below.
 #include "kernels/bank.hpp"
 #include "kernels/for_each_member.hpp"
-#include "kernels/linear_algebra.hpp"
-#include "kernels/math.hpp"
+#include "core/linear_algebra.hpp"
+#include "core/math.hpp"
 #include "kernels/particle_filter/particle_draws.hpp"
 #include "kernels/particle_filter/particle_model_traits.hpp"
 #include "kernels/vector_math.hpp"
 #include "kernels/particle_filter/weighted_moments.hpp"
 #include "kernels/rng.hpp"
-#include "kernels/status.hpp"
+#include "core/status.hpp"
 
 #include <Kokkos_Core.hpp>
 
@@ -262,13 +262,6 @@ KOKKOS_INLINE_FUNCTION double log_weight_bound(const Vec<P>& dy, const Vec<P>& v
   return math::is_finite(bound) ? bound : 0.0;
 }
 
-// Full unrolling of the GPU kernel's fixed-size particle loops (nvcc's device pass; GCC would warn).
-#if defined(__CUDA_ARCH__)
-#define KUSHNER_DEVICE_UNROLL _Pragma("unroll")
-#else
-#define KUSHNER_DEVICE_UNROLL
-#endif
-
 /// GPU kernel: a team per (chunk, member). Each thread takes its particles in batches of P: all loads of a
 /// batch are issued before the first use, so a warp keeps 2 P loads in flight. The weights are summed as
 /// e = exp(l - s) with one shift s per member and step, s = log_weight_bound (the largest l any particle can
@@ -489,7 +482,7 @@ struct ParticleTeamStep {
     double v[values];
     w.store(v);
     const double* total = &buffer(threads * values);
-#if defined(__CUDA_ARCH__)
+#if KUSHNER_CUDA_DEVICE_PASS
     if (threads % 32 == 0) {  // Kokkos' CUDA teams: team rank = thread index in the block (vector length 1)
       KUSHNER_DEVICE_UNROLL
       for (int offset = 16; offset > 0; offset /= 2) {

@@ -1,7 +1,6 @@
 #pragma once
-// The resampling schemes of the particle filter, and their names on the command line.
-#include "kernels/errors.hpp"
-
+// The resampling schemes of the particle filter, and their names.
+#include <optional>
 #include <string>
 
 namespace kushner {
@@ -20,12 +19,12 @@ inline const char* to_string(ResamplingScheme s) {
   return "unknown";
 }
 
-/// InputError naming the known schemes for anything else.
-inline ResamplingScheme parse_resampling_scheme(const std::string& name) {
+/// The scheme called `name`, if there is one.
+inline std::optional<ResamplingScheme> resampling_scheme_named(const std::string& name) {
   for (auto s : {ResamplingScheme::systematic, ResamplingScheme::stratified, ResamplingScheme::multinomial,
                  ResamplingScheme::residual})
     if (name == to_string(s)) return s;
-  throw InputError("--resample: unknown scheme '" + name + "' (known: multinomial, residual, stratified, systematic)");
+  return std::nullopt;
 }
 
 }  // namespace kushner

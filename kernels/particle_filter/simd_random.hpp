@@ -4,9 +4,9 @@
 // conversion has no AVX2 instruction). Same counters, same 52-bit uniforms as kernels/rng.hpp, bit for bit
 // (tests/test_particle_random.cpp); only the host particle kernel uses it, the GPU keeps Random123's version,
 // which uses the hardware's 32-bit multiply-high.
-#include "kernels/math.hpp"
+#include "core/math.hpp"
 #include "kernels/rng.hpp"
-#include "kernels/small_matrix.hpp"
+#include "core/small_matrix.hpp"
 
 #include <cstdint>
 #include <cstring>

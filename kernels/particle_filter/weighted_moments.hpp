@@ -5,7 +5,7 @@
 // number of threads. Positions are kept relative to a reference point (the previous posterior mean), so the
 // covariance does not lose digits when the mean is large compared to the spread.
 #include "kernels/bank.hpp"
-#include "kernels/math.hpp"
+#include "core/math.hpp"
 
 #include <Kokkos_Core.hpp>
 

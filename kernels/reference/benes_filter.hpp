@@ -13,10 +13,10 @@
 // and variance are c + s tanh c and s + s^2 sech^2 c; x_0 has posterior ∝ N(z; M_z, S_zz) cosh(c(z)) /
 // cosh(z), integrated by Gauss-Hermite quadrature. Checked numerically in notes/benes_check.py.
 #include "kernels/bank.hpp"
-#include "kernels/errors.hpp"
+#include "core/errors.hpp"
 #include "kernels/for_each_member.hpp"
-#include "kernels/math.hpp"
-#include "kernels/status.hpp"
+#include "core/math.hpp"
+#include "core/status.hpp"
 #include "models/benes_model.hpp"
 
 #include <Kokkos_Core.hpp>

@@ -16,12 +16,12 @@
 // min_resolution() reports the smallest sigma / h met. Axis-aligned noise only (G G^T diagonal).
 // One member per work item, sequential over the grid: a reference, not a fast path.
 #include "kernels/bank.hpp"
-#include "kernels/errors.hpp"
+#include "core/errors.hpp"
 #include "kernels/for_each_member.hpp"
-#include "kernels/linear_algebra.hpp"
-#include "kernels/math.hpp"
-#include "kernels/status.hpp"
-#include "models/model_checks.hpp"
+#include "core/linear_algebra.hpp"
+#include "core/math.hpp"
+#include "core/status.hpp"
+#include "core/eigen_helpers.hpp"
 
 #include <Kokkos_Core.hpp>
 

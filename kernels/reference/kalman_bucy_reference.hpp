@@ -10,10 +10,10 @@
 // only; as dt -> 0 it converges to the continuous Kalman-Bucy filter with error O(dt). One member per
 // work item; the filter bank (KB there) has its own continuous-time implementation.
 #include "kernels/bank.hpp"
-#include "kernels/errors.hpp"
+#include "core/errors.hpp"
 #include "kernels/for_each_member.hpp"
-#include "kernels/linear_algebra.hpp"
-#include "kernels/status.hpp"
+#include "core/linear_algebra.hpp"
+#include "core/status.hpp"
 #include "models/linear_model.hpp"
 
 #include <Kokkos_Core.hpp>

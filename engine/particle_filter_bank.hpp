@@ -18,9 +18,9 @@
 // step_pair takes two steps with one pass over the particles where the team kernel and the chunked
 // resampling run (the GPU's default): see step_pair.
 #include "kernels/bank.hpp"
-#include "kernels/errors.hpp"
+#include "core/errors.hpp"
 #include "kernels/for_each_member.hpp"
-#include "kernels/linear_algebra.hpp"
+#include "core/linear_algebra.hpp"
 #include "kernels/particle_filter/chunked_systematic_resample.hpp"
 #include "kernels/particle_filter/copy_listed_members.hpp"
 #include "kernels/particle_filter/particle_posterior.hpp"
@@ -28,7 +28,7 @@
 #include "kernels/particle_filter/particle_step.hpp"
 #include "kernels/particle_filter/resampling.hpp"
 #include "kernels/particle_filter/resampling_scheme.hpp"
-#include "models/model_checks.hpp"
+#include "core/eigen_helpers.hpp"
 
 #include <Kokkos_Core.hpp>
 
@@ -70,16 +70,16 @@ class ParticleFilterBank {
       : ParticleFilterBank(space, model, num_members, num_particles, seed,
                            ParticleFilterOptions{scheme, ess_threshold}) {}
 
-  /// Samples the initial particles and computes the time-0 posterior. InputError for sizes < 1 or a
-  /// threshold outside [0, 1].
+  /// Samples the initial particles and computes the time-0 posterior. Requires sizes >= 1 and a threshold in
+  /// [0, 1] (std::logic_error otherwise: user input is checked where it is read, drivers/filter_options.cpp).
   ParticleFilterBank(const ExecSpace& space, const Model& model, int num_members, int num_particles,
                      std::uint32_t seed, const ParticleFilterOptions& options)
       : space_(space), model_(model), options_(options), seed_(seed), num_members_(num_members),
         num_particles_(num_particles) {
-    KUSHNER_INPUT_REQUIRE(num_members >= 1, "members: must be at least 1 (got " << num_members << ")");
-    KUSHNER_INPUT_REQUIRE(num_particles >= 1, "--particles: must be at least 1 (got " << num_particles << ")");
-    KUSHNER_INPUT_REQUIRE(options.ess_threshold >= 0.0 && options.ess_threshold <= 1.0,
-                          "--ess-threshold: must be in [0, 1] (got " << options.ess_threshold << ")");
+    KUSHNER_REQUIRE(num_members >= 1, "members: " << num_members);
+    KUSHNER_REQUIRE(num_particles >= 1, "particles: " << num_particles);
+    KUSHNER_REQUIRE(options.ess_threshold >= 0.0 && options.ess_threshold <= 1.0,
+                    "ess_threshold: " << options.ess_threshold);
     use_team_ = options.kernel == ParticleKernel::team ||
                 (options.kernel == ParticleKernel::automatic && !std::is_same<MemSpace, Kokkos::HostSpace>::value);
     constexpr bool host_memory = std::is_same<MemSpace, Kokkos::HostSpace>::value;

@@ -1,18 +1,13 @@
 #pragma once
-// The one place where Kokkos version differences in math live: Kokkos 3.4 keeps its device-callable math
-// functions in Kokkos::Experimental, Kokkos 4 in Kokkos.
+// Device-callable math: Kokkos' functions (core/portability.hpp picks their namespace) and a few of our own.
+#include "core/portability.hpp"
+
 #include <Kokkos_Core.hpp>
 
 #include <cstdint>
 #include <cstring>
 
 namespace kushner::math {
-
-#if KOKKOS_VERSION >= 40000
-namespace impl = ::Kokkos;
-#else
-namespace impl = ::Kokkos::Experimental;
-#endif
 
 using impl::atan;
 using impl::atan2;
@@ -53,7 +48,7 @@ KOKKOS_INLINE_FUNCTION double square(double v) { return v * v; }
 /// c = cos(2 pi u), s = sin(2 pi u). On a GPU CUDA's sincospi: no range reduction and one polynomial pair for
 /// both (the angle 2 pi u is never rounded); elsewhere libm's (or libmvec's) cos and sin of the rounded angle.
 KOKKOS_INLINE_FUNCTION void cos_sin_two_pi(double u, double& c, double& s) {
-#if defined(__CUDA_ARCH__)
+#if KUSHNER_CUDA_DEVICE_PASS
   ::sincospi(2.0 * u, &s, &c);
 #else
   // The same angle twice, as (2 pi) u and pi (2 u): equal bits (both products are exact before the one

@@ -3,9 +3,9 @@
 // per member. A snapshot copies the particles and normalized weights to the host once (of every member, or of
 // a few chosen ones); every statistic below is then computed there, in particle order, so it is
 // deterministic. Host code only.
-#include "kernels/errors.hpp"
+#include "core/errors.hpp"
 #include "kernels/host_copy.hpp"
-#include "kernels/particle_filter/particle_filter_bank.hpp"
+#include "engine/particle_filter_bank.hpp"
 
 #include <Kokkos_Core.hpp>
 

@@ -1,7 +1,7 @@
 #pragma once
 // `--model-file FILE`: the polynomial model (models/polynomial_model.hpp) a model file describes
 // (models/polynomial_spec.hpp: the format), its record in summary.json, and the dispatch on its dimension.
-#include "kernels/errors.hpp"
+#include "core/errors.hpp"
 #include "models/model_checks.hpp"
 #include "models/parameters.hpp"
 #include "models/polynomial_model.hpp"
@@ -89,7 +89,7 @@ nlohmann::json polynomial_model_json(const PolynomialModel<N>& model) {
                        {{"a0", std::vector<double>(model.a0.v, model.a0.v + N)},
                         {"a1", matrix(model.a1, N, N)},
                         {"terms", terms},
-                        {"degree", model.degree()}}},
+                        {"degree", model.drift_facts().degree}}},
                       {"diffusion", {{"b", matrix(model.b, N, q)}}},
                       {"observation",
                        {{"c0", std::vector<double>(model.c0.v, model.c0.v + p)},

@@ -4,20 +4,31 @@
 // filters. The bank scores each like a filter (rmse_truth, nees, diverged) and scores every filter against
 // the one chosen as the reference (rmse_ref). Host-side polymorphism only: each implementation runs its own
 // kernels, dispatched at compile time on the model.
+#include "core/fields.hpp"
+#include "core/status.hpp"
+#include "engine/particle_snapshot.hpp"
 #include "kernels/bank.hpp"
-#include "kernels/status.hpp"
 
-#include <nlohmann/json.hpp>
-
+#include <optional>
 #include <string>
+#include <vector>
 
 namespace kushner {
+
+/// The names under which the estimators beside the bank are selected and reported.
+inline constexpr const char* particle_filter_name = "PF";
+inline constexpr const char* exact_filter_name = "EXACT";
+
+/// Whether `name` is an estimator beside the bank (PF, EXACT) rather than a filter of it.
+inline bool is_outside_estimator(const std::string& name) {
+  return name == particle_filter_name || name == exact_filter_name;
+}
 
 template <class MemSpace>
 class ReferenceEstimator {
  public:
   virtual ~ReferenceEstimator() = default;
-  /// The name in outputs and on the command line ("PF", "EXACT").
+  /// The name in outputs and in filter lists (particle_filter_name, exact_filter_name, ...).
   virtual std::string name() const = 0;
   /// Takes step k over [t, t + dt] given dy(member, j), the increments the truths just produced.
   virtual void advance(long k, double t, double dt, const BankVector<MemSpace>& dy) = 0;
@@ -27,8 +38,12 @@ class ReferenceEstimator {
   virtual BankSymmetric<MemSpace> covariance() const = 0;
   /// (member): ok while the member's estimate is usable.
   virtual BankScalar<Status, MemSpace> status() const = 0;
-  /// What summary.json says about it: {"kind": ..., and the estimator's own figures}.
-  virtual nlohmann::json describe() const = 0;
+  /// What the summary says about it: "kind", and the estimator's own figures.
+  virtual Fields describe() const = 0;
+  /// For an estimator made of particles: a host copy of the chosen members' particles and weights.
+  virtual std::optional<ParticleSnapshot> particle_snapshot(const std::vector<int>& /*members*/) const {
+    return std::nullopt;
+  }
 };
 
 }  // namespace kushner

@@ -1,6 +1,6 @@
 #include "models/polynomial_spec.hpp"
 
-#include "kernels/errors.hpp"
+#include "core/errors.hpp"
 #include "models/polynomial_monomials.hpp"
 
 #include <toml++/toml.h>

@@ -1,12 +1,12 @@
 #pragma once
-// The bank of truths and filters on one execution space: the truths (drivers/simulate_ensemble.hpp), every
+// The bank of truths and filters on one execution space: the truths (engine/truth_bank.hpp), every
 // filter the model supports as a slot (kernels/filters/filter_slot.hpp) with the selected ones allocated and
 // enabled, the fused step kernel, and the reductions behind the reported metrics. Estimators outside the bank
-// (particle filter, exact filters: drivers/reference_estimator.hpp) step on the same dy right after it and are
+// (particle filter, exact filters: engine/reference_estimator.hpp) step on the same dy right after it and are
 // scored like filters; one of them may be the reference that every other estimate is measured against. Reductions go through
 // ensemble_moments (fixed-order blocks), so every number is the same on any number of threads.
-#include "drivers/reference_estimator.hpp"
-#include "drivers/simulate_ensemble.hpp"
+#include "engine/reference_estimator.hpp"
+#include "engine/truth_bank.hpp"
 #include "kernels/ensemble_moments.hpp"
 #include "kernels/filters/filter_bank_step.hpp"
 #include "kernels/filters/filter_list.hpp"
@@ -18,7 +18,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace kushner {
@@ -65,15 +67,22 @@ class FilterBank {
     using Step = FilterBankStep<Model, TruthModel, MemSpace, Filters...>;
     using Initial = FilterBankInitialScore<Model, MemSpace, Filters...>;
     using Reference = FilterBankReferenceScore<Model, MemSpace, BankVector<MemSpace>, Filters...>;
+    using Prepared = std::tuple<std::optional<Filters>...>;
   };
   using K = Kernels<SupportedFilters<Model, MemSpace>>;
 
  public:
-  /// `filters`: names from select_filters<Model>() (supported, report order). The truths follow truth_model,
-  /// the filters filter_model (the same in most runs; tests set them apart to show that a test can fail, and
+  /// Filters made before the bank (by their pre-pass, or by hand in tests): std::get<std::optional<Filter>>.
+  /// The bank creates the others with Filter::create.
+  using PreparedFilters = typename K::Prepared;
+
+  /// `filters`: names of filters the model supports (supported_filters, engine/filter_catalog.hpp), in report
+  /// order; `options`: their settings (declared defaults where absent). The truths follow truth_model, the
+  /// filters filter_model (the same in most runs; tests set them apart to show that a test can fail, and
   /// `kushner reproduce` runs filters of a Taylor model on the system it approximates).
   FilterBank(const ExecSpace& space, const TruthModel& truth_model, const Model& filter_model, long members,
-             std::uint32_t seed, const std::vector<std::string>& filters, const FilterConfig& config)
+             std::uint32_t seed, const std::vector<std::string>& filters, const OptionValues& options = {},
+             const PreparedFilters& prepared = {})
       : space_(space),
         truth_model_(truth_model),
         filter_model_(filter_model),
@@ -88,7 +97,8 @@ class FilterBank {
         if (name != Filter::name) return;
         found = true;
         slot.enabled = true;
-        slot.filter = Filter::create(config, filter_model, members);
+        const std::optional<Filter>& ready = std::get<std::optional<Filter>>(prepared);
+        slot.filter = ready ? *ready : Filter::create(options.with_defaults(filter_options<Filter>()), filter_model, members);
         slot.m = BankVector<MemSpace>(std::string("kushner::m_") + Filter::name, members, n);
         slot.P = BankSymmetric<MemSpace>(std::string("kushner::P_") + Filter::name, members, packed_size(n));
         slot.status = BankScalar<Status, MemSpace>(std::string("kushner::status_") + Filter::name, members);
@@ -176,6 +186,28 @@ class FilterBank {
   template <template <class, class> class Filter>
   const FilterSlot<Filter<Model, MemSpace>, MemSpace>& slot() const {
     return static_cast<const FilterSlot<Filter<Model, MemSpace>, MemSpace>&>(slots_);
+  }
+
+  /// What filter `name` (a selected one) adds to its summary (kernels/filters/filter_protocol.hpp).
+  Fields summary_fields(const std::string& name) const {
+    Fields fields;
+    for_each_slot([&](const auto& slot) {
+      if (slot.enabled && name == decltype(slot.filter)::name) fields = filter_summary_fields(slot.filter);
+    });
+    return fields;
+  }
+
+  /// Per member: whether filter `name` and the member's truth are still finite and well defined.
+  std::vector<char> members_ok(const std::string& name) const {
+    std::vector<char> ok(members_, 0);
+    space_.fence();
+    const auto truth_status = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), truth_status_);
+    with_slot(name, [&](const auto& slot) {
+      const auto status = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), slot.status);
+      for (long member = 0; member < members_; ++member)
+        ok[member] = status(member) == Status::ok && truth_status(member) == Status::ok;
+    });
+    return ok;
   }
 
   /// Metrics of filter `name` at the latest output time.

@@ -1,5 +1,5 @@
 #pragma once
-// Host-side errors. Kernels never throw: they record a per-member Status instead (kernels/status.hpp).
+// Host-side errors. Kernels never throw: they record a per-member Status instead (core/status.hpp).
 #include <sstream>
 #include <stdexcept>
 #include <string>

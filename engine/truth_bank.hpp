@@ -1,11 +1,11 @@
 #pragma once
 // Simulates the bank of truths over a time grid and records ensemble moments at the grid's output steps.
 // Shared by `kushner simulate`, the tests and the benchmarks.
-#include "drivers/progress.hpp"
-#include "drivers/run_options.hpp"
+#include "engine/progress_callback.hpp"
+#include "engine/time_grid.hpp"
 #include "kernels/ensemble_moments.hpp"
 #include "kernels/simulate_truth.hpp"
-#include "models/model_checks.hpp"
+#include "core/eigen_helpers.hpp"
 
 #include <cstdint>
 #include <vector>
@@ -50,7 +50,7 @@ class TruthBank {
 
 template <class ExecSpace, class Model>
 MomentSeries simulate_ensemble(const ExecSpace& space, const Model& model, long members, std::uint32_t seed,
-                               const TimeGrid& grid, Progress* progress = nullptr) {
+                               const TimeGrid& grid, const ProgressCallback& progress = {}) {
   TruthBank<ExecSpace, Model> bank(space, model, members, seed);
   MomentSeries series;
   std::size_t next_output = 0;
@@ -62,7 +62,7 @@ MomentSeries simulate_ensemble(const ExecSpace& space, const Model& model, long 
     }
     if (k == grid.steps) break;
     bank.step(k, grid.dt);
-    if (progress) progress->update(k + 1);
+    if (progress) progress(k + 1);
   }
   space.fence();
   return series;

@@ -5,9 +5,9 @@
 // the squared Monte Carlo error of the particle mean (Kong, Liu & Wong 1994): rmse_ref cannot tell apart
 // filters closer to the particle mean than its root mean, the reference's noise floor. Reduced on the host
 // in member order, so the figures are the same on any number of threads.
-#include "drivers/reference_estimator.hpp"
+#include "engine/reference_estimator.hpp"
 #include "kernels/for_each_member.hpp"
-#include "kernels/particle_filter/particle_filter_bank.hpp"
+#include "engine/particle_filter_bank.hpp"
 
 #include <Kokkos_Core.hpp>
 
@@ -58,7 +58,7 @@ class ParticleReference final : public ReferenceEstimator<typename ExecSpace::me
         pf_(space, model, static_cast<int>(members), settings.particles, seed, settings.options),
         sums_("kushner::particle_reference_sums", members, 2) {}
 
-  std::string name() const override { return "PF"; }
+  std::string name() const override { return particle_filter_name; }
   void advance(long k, double, double dt, const BankVector<MemSpace>& dy) override {
     pf_.step(k, dt, dy);
     parallel_for_members(
@@ -70,7 +70,7 @@ class ParticleReference final : public ReferenceEstimator<typename ExecSpace::me
   BankSymmetric<MemSpace> covariance() const override { return pf_.posterior_covariance(); }
   BankScalar<Status, MemSpace> status() const override { return pf_.status(); }
 
-  nlohmann::json describe() const override {
+  Fields describe() const override {
     space_.fence();
     const auto sums = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sums_);
     const auto resamples = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pf_.resample_count());
@@ -81,14 +81,18 @@ class ParticleReference final : public ReferenceEstimator<typename ExecSpace::me
       ess_total += sums(m, 0), squared_error_total += sums(m, 1), resample_total += resamples(m);
     }
     const double member_steps = static_cast<double>(pf_.num_members()) * steps_;
-    return {{"kind", "particle filter"},
-            {"particles", pf_.num_particles()},
-            {"resampling", to_string(pf_.options().scheme)},
+    return {{"kind", std::string("particle filter")},
+            {"particles", static_cast<long>(pf_.num_particles())},
+            {"resampling", std::string(to_string(pf_.options().scheme))},
             {"ess_threshold", pf_.options().ess_threshold},
             {"mean_ess", steps_ > 0 ? ess_total / member_steps : std::nan("")},
             {"noise_floor", steps_ > 0 ? std::sqrt(squared_error_total / member_steps) : std::nan("")},
             {"resamples", resample_total},
             {"resamples_per_member_step", steps_ > 0 ? resample_total / member_steps : std::nan("")}};
+  }
+
+  std::optional<ParticleSnapshot> particle_snapshot(const std::vector<int>& members) const override {
+    return ParticleSnapshot(pf_, members);
   }
 
   const ParticleFilterBank<ExecSpace, Model>& bank() const { return pf_; }

@@ -2,8 +2,9 @@
 // `--filters EXACT`: the exact filter where the model has one (Kalman for linear models, Benes' closed form)
 // or the grid (point-mass) filter for the other models of dimension 1 and 2 (kernels/reference/), as an
 // estimator beside the bank. Like the particle filter it starts from the filters' prior.
-#include "drivers/reference_estimator.hpp"
+#include "engine/reference_estimator.hpp"
 #include "kernels/reference/exact_reference.hpp"
+#include "models/model_traits.hpp"
 
 #include <type_traits>
 
@@ -13,6 +14,16 @@ namespace kushner {
 /// depend on it).
 template <class Model>
 constexpr bool has_exact_reference = !std::is_void_v<exact_reference_t<Kokkos::DefaultHostExecutionSpace, Model>>;
+
+/// Why the exact filter cannot run `model`, or nullptr: no exact or grid filter for its type, or (a model known
+/// only at run time) noise the grid filter cannot take.
+template <class Model>
+const char* exact_filter_unsupported(const Model& model) {
+  if (!has_exact_reference<Model>) return "no exact filter, and no grid filter above dimension 2 or for discrete time";
+  if constexpr (ModelTraits<Model>::runtime_checked)
+    if (!model.drift_facts().axis_aligned_noise) return "the grid filter needs axis-aligned noise (b b^T diagonal)";
+  return nullptr;
+}
 
 template <class ExecSpace, class Model>
 class ExactReferenceEstimator final : public ReferenceEstimator<typename ExecSpace::memory_space> {
@@ -24,18 +35,21 @@ class ExactReferenceEstimator final : public ReferenceEstimator<typename ExecSpa
   ExactReferenceEstimator(const ExecSpace& space, const Model& model, long members)
       : reference_(space, model, static_cast<int>(members)) {}
 
-  std::string name() const override { return "EXACT"; }
+  std::string name() const override { return exact_filter_name; }
   void advance(long k, double, double dt, const BankVector<MemSpace>& dy) override { reference_.step(k, dt, dy); }
   BankVector<MemSpace> mean() const override { return reference_.posterior_mean(); }
   BankSymmetric<MemSpace> covariance() const override { return reference_.posterior_covariance(); }
   BankScalar<Status, MemSpace> status() const override { return reference_.status(); }
-  nlohmann::json describe() const override {
+  Fields describe() const override {
+    const auto fields = [](const char* kind, const char* note) {
+      return Fields{{"kind", std::string(kind)}, {"note", std::string(note)}};
+    };
     if constexpr (std::is_same_v<Reference, BenesFilter<ExecSpace>>)
-      return {{"kind", "benes"}, {"note", "Benes closed form (exact)"}};
+      return fields("benes", "Benes closed form (exact)");
     else if constexpr (std::is_same_v<Reference, GridFilter<ExecSpace, Model>>)
-      return {{"kind", "grid"}, {"note", "point-mass grid filter (Fokker-Planck prediction, Bayes update)"}};
+      return fields("grid", "point-mass grid filter (Fokker-Planck prediction, Bayes update)");
     else
-      return {{"kind", "kalman"}, {"note", "Kalman filter of the Euler-Maruyama discretization (exact for it)"}};
+      return fields("kalman", "Kalman filter of the Euler-Maruyama discretization (exact for it)");
   }
 
  private:

@@ -13,13 +13,13 @@
 // outside: 1e-15), spectrally accurate for a smooth integrand once the spacing is below the posterior's width.
 // Its quadrature error is estimated at each step as |mean - mean on every second node| (the rule with twice
 // the spacing), whose largest value over the run describe() reports: it bounds the error of the mean used.
-#include "drivers/reference_estimator.hpp"
+#include "engine/reference_estimator.hpp"
 #include "kernels/bank.hpp"
-#include "kernels/errors.hpp"
+#include "core/errors.hpp"
 #include "kernels/for_each_member.hpp"
-#include "kernels/linear_algebra.hpp"
-#include "kernels/math.hpp"
-#include "models/model_checks.hpp"
+#include "core/linear_algebra.hpp"
+#include "core/math.hpp"
+#include "core/eigen_helpers.hpp"
 
 #include <Eigen/Dense>
 #include <Kokkos_Core.hpp>
@@ -161,16 +161,15 @@ class PriorLineReference final : public ReferenceEstimator<typename ExecSpace::m
   BankVector<MemSpace> mean() const override { return mean_; }
   BankSymmetric<MemSpace> covariance() const override { return covariance_; }
   BankScalar<Status, MemSpace> status() const override { return status_; }
-  nlohmann::json describe() const override {
+  Fields describe() const override {
     space_.fence();
     const auto error = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), error_);
     double largest = 0.0;
     for (std::size_t member = 0; member < error.extent(0); ++member) largest = std::max(largest, error(member));
-    return {{"kind", "prior-line quadrature"},
-            {"note",
-             "exact conditional law of the filters' model for deterministic dynamics and a rank-1 prior: "
-             "likelihood-weighted points of the prior's line, trapezoidal rule"},
-            {"nodes", nodes_},
+    return {{"kind", std::string("prior-line quadrature")},
+            {"note", std::string("exact conditional law of the filters' model for deterministic dynamics and a rank-1 "
+                                 "prior: likelihood-weighted points of the prior's line, trapezoidal rule")},
+            {"nodes", static_cast<long>(nodes_)},
             {"half_width_sd", half_width},
             {"quadrature_error", largest}};
   }

@@ -1,4 +1,4 @@
-#include "drivers/backend.hpp"
+#include "engine/backend.hpp"
 
 #include <cstdlib>
 #include <sstream>
@@ -30,22 +30,20 @@ std::string selected_backend() {
   throw InputError(std::string("KUSHNER_BACKEND: backend '") + env + "' is not available (built: " + known + ")");
 }
 
-nlohmann::json describe_backend(const std::string& name) {
+BackendDescription describe_backend(const std::string& name) {
   std::ostringstream kokkos;
   kokkos << KOKKOS_VERSION / 10000 << "." << (KOKKOS_VERSION / 100) % 100 << "." << KOKKOS_VERSION % 100;
-  nlohmann::json j = {{"name", name}, {"kokkos", kokkos.str()}};
+  BackendDescription d;
+  d.name = name;
+  d.kokkos = kokkos.str();
 #if defined(KOKKOS_ENABLE_CUDA)
-  if (name == "cuda") {
-    const Kokkos::Cuda cuda;
-    j["device"] = cuda.cuda_device_prop().name;
-    return j;
-  }
+  if (name == "cuda") d.device = Kokkos::Cuda().cuda_device_prop().name;
 #endif
 #if defined(KOKKOS_ENABLE_OPENMP)
-  if (name == "openmp") j["threads"] = Kokkos::OpenMP().concurrency();
+  if (name == "openmp") d.threads = Kokkos::OpenMP().concurrency();
 #endif
-  if (name == "serial") j["threads"] = 1;
-  return j;
+  if (name == "serial") d.threads = 1;
+  return d;
 }
 
 KokkosSession::KokkosSession() {

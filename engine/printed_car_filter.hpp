@@ -8,7 +8,7 @@
 // dp_ff and dp_dd are as (10) gives them. Gain P, i.e. V = I, as printed. Discretized like the bank's filters
 // (kernels/filters/filter_step.hpp): update with dy, then an Euler step of the printed drift terms (which are not
 // of the form J P + P J^T, so P += D dt rather than the congruence).
-#include "drivers/reference_estimator.hpp"
+#include "engine/reference_estimator.hpp"
 #include "kernels/bank.hpp"
 #include "kernels/filters/filter_step.hpp"
 #include "kernels/for_each_member.hpp"
@@ -95,9 +95,9 @@ class PrintedCarFilter final : public ReferenceEstimator<typename ExecSpace::mem
   BankVector<MemSpace> mean() const override { return m_; }
   BankSymmetric<MemSpace> covariance() const override { return P_; }
   BankScalar<Status, MemSpace> status() const override { return status_; }
-  nlohmann::json describe() const override {
-    return {{"kind", "printed equations"},
-            {"note", "seed 002 (21) as printed: mean term (v/3l)(3 p_dd + m_d^3), dp_fd without (v/l) p_dd^2"}};
+  Fields describe() const override {
+    return {{"kind", std::string("printed equations")},
+            {"note", std::string("seed 002 (21) as printed: mean term (v/3l)(3 p_dd + m_d^3), dp_fd without (v/l) p_dd^2")}};
   }
 
  private:

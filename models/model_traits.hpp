@@ -2,6 +2,7 @@
 // What a model offers the filters, detected at compile time, and the structured drift forms derived from the
 // most specific one a model has (a linear model is also a degree-1 polynomial and its own SDC factorization).
 // Filters read these to decide, at compile time, whether they support a model (kernels/filters/filter_list.hpp).
+#include "models/drift_facts.hpp"
 #include "models/drift_forms.hpp"
 
 #include <type_traits>
@@ -47,14 +48,12 @@ struct declares_linear_observation : std::false_type {};
 template <class Model>
 struct declares_linear_observation<Model, std::enable_if_t<Model::linear_observation>> : std::true_type {};
 
-/// `const char* filter_unsupported(const char* filter) const`: a model whose structure is known only at run
-/// time (a --model-file polynomial) says which filters its coefficients rule out.
+/// `DriftFacts drift_facts() const`: a model whose structure is known only at run time (a --model-file
+/// polynomial) states what its coefficients are.
 template <class Model, class = void>
-struct has_runtime_filter_check : std::false_type {};
+struct has_drift_facts : std::false_type {};
 template <class Model>
-struct has_runtime_filter_check<
-    Model, std::void_t<decltype(std::declval<const Model&>().filter_unsupported(std::declval<const char*>()))>>
-    : std::true_type {};
+struct has_drift_facts<Model, std::void_t<decltype(std::declval<const Model&>().drift_facts())>> : std::true_type {};
 
 template <class Model, class = void>
 struct declares_non_integrable_drift : std::false_type {};
@@ -62,13 +61,13 @@ template <class Model>
 struct declares_non_integrable_drift<Model, std::enable_if_t<!Model::drift_gaussian_integrable>> : std::true_type {};
 }  // namespace detail
 
-/// Capabilities of a continuous-time model, as the filters see them. For a model with a run-time check
+/// Capabilities of a continuous-time model, as the filters see them. For a model with run-time facts
 /// (`runtime_checked`) they say what its type can offer; its forms (linear_form, drift_power_polynomial,
-/// drift_quadratic_polynomial) describe the whole drift only for the filters filter_unsupported() does not
-/// refuse, and drivers/filter_selection.hpp asks it before any filter runs.
+/// drift_quadratic_polynomial) describe the whole drift only where its drift_facts() allow, which every filter
+/// checks before it runs (kernels/filters/filter_protocol.hpp).
 template <class Model>
 struct ModelTraits {
-  static constexpr bool runtime_checked = detail::has_runtime_filter_check<Model>::value;
+  static constexpr bool runtime_checked = detail::has_drift_facts<Model>::value;
   static constexpr bool linear = detail::has_linear_form<Model>::value;
   /// h(t, x) = h(t, 0) + H x, H = observation_jacobian(t, .) constant in x.
   static constexpr bool linear_observation = linear || detail::declares_linear_observation<Model>::value;
@@ -89,16 +88,6 @@ struct ModelTraits {
       return linear ? 1 : 0;
   }
 };
-
-/// Why `filter` (a filter's, "PF"'s or "EXACT"'s name) cannot run this model's coefficients, or nullptr: the
-/// run-time check of models that have one (ModelTraits::runtime_checked), else nullptr.
-template <class Model>
-const char* runtime_filter_unsupported(const Model& model, const char* filter) {
-  if constexpr (detail::has_runtime_filter_check<Model>::value)
-    return model.filter_unsupported(filter);
-  else
-    return nullptr;
-}
 
 /// The drift as a componentwise power polynomial (degree 1 for a linear model).
 template <class Model>

@@ -2,11 +2,9 @@
 // Which Kokkos execution space a run uses. The command line says what to compute; the environment says
 // where: KUSHNER_BACKEND=serial|openmp|cuda (default: Kokkos' default execution space) and OMP_NUM_THREADS.
 // So the recorded command, and every per-member number, is the same whatever backend ran it.
-#include "kernels/errors.hpp"
+#include "core/errors.hpp"
 
 #include <Kokkos_Core.hpp>
-
-#include <nlohmann/json.hpp>
 
 #include <string>
 #include <vector>
@@ -19,8 +17,14 @@ std::vector<std::string> available_backends();
 /// KUSHNER_BACKEND if set (checked against available_backends(): InputError otherwise), else the default.
 std::string selected_backend();
 
-/// {"name", "threads" or "device", "kokkos"}: recorded in every summary. Needs Kokkos initialized.
-nlohmann::json describe_backend(const std::string& name);
+/// What a run records about where it ran. Needs Kokkos initialized.
+struct BackendDescription {
+  std::string name;    // an available_backends() name
+  std::string kokkos;  // Kokkos version, "3.4.1"
+  int threads = 0;     // host backends; 0 on a GPU
+  std::string device;  // GPU name; empty on the host
+};
+BackendDescription describe_backend(const std::string& name);
 
 /// Calls f(space) with an instance of the execution space called `name`.
 template <class F>

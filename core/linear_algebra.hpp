@@ -1,8 +1,8 @@
 #pragma once
 // Small dense factorizations for one member's covariance: Cholesky, solves, inverse. Device-callable; they
 // report failure (not positive definite) through their return value, never by throwing.
-#include "kernels/math.hpp"
-#include "kernels/small_matrix.hpp"
+#include "core/math.hpp"
+#include "core/small_matrix.hpp"
 
 namespace kushner {
 

@@ -1,0 +1,182 @@
+#pragma once
+// A whole filter run over a time grid: the bank of truths and filters stepped from 0 to T, metrics collected
+// at the grid's output times and over the run. A filter that needs a pass over the whole horizon first (ASRE
+// iterates until its estimate trajectory settles) gets its pre-pass here, through its own `prepare`
+// (kernels/filters/filter_protocol.hpp); the main pass then runs what it prepared. The particle filter (PF) and
+// the exact or grid filter (EXACT) run beside the bank when named among the filters; the particle filter (else
+// the exact filter) is then the reference of rmse_ref. Shared by `kushner filter`, `kushner compare`, the tests
+// and the benchmarks.
+#include "core/fields.hpp"
+#include "core/options.hpp"
+#include "engine/exact_reference_estimator.hpp"
+#include "engine/filter_bank.hpp"
+#include "engine/particle_reference.hpp"
+#include "engine/progress_callback.hpp"
+#include "engine/time_grid.hpp"
+
+#include <Kokkos_Core.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace kushner {
+
+struct FilterReport {
+  std::vector<std::string> filters;                 // report order
+  std::vector<double> times;                        // output times
+  std::vector<std::vector<FilterSnapshot>> series;  // [time][filter]
+  std::vector<FilterScores> scores;                 // [filter], over the whole run
+  long truths_escaped = 0;                          // members left out of every metric
+  bool has_reference = false;
+  std::string reference;                            // the reference's name (PF, EXACT) when has_reference
+  std::map<std::string, Fields> filter_fields;      // bank filter -> what it adds to its summary
+  std::map<std::string, Fields> estimators;         // estimator beside the bank -> its describe()
+};
+
+/// Called at t = 0 and at every output time with the bank and the outside estimators (PF, EXACT), e.g. to
+/// record chosen members' trajectories.
+template <class ExecSpace, class Model, class TruthModel = Model>
+using OutputObserver =
+    std::function<void(double t, const FilterBank<ExecSpace, Model, TruthModel>&,
+                       const std::vector<const ReferenceEstimator<typename ExecSpace::memory_space>*>&)>;
+
+/// Estimators a caller adds beside the bank (e.g. `kushner reproduce`'s exact quadrature for a deterministic
+/// model, or a paper's printed variant of a filter); run_filters owns them from then on.
+template <class ExecSpace>
+using ExtraEstimators = std::vector<std::unique_ptr<ReferenceEstimator<typename ExecSpace::memory_space>>>;
+
+/// Steps a run of `filters` reports to its progress callback: the main pass and every pre-pass.
+template <class Model>
+long progress_steps(const std::vector<std::string>& filters, const TimeGrid& grid) {
+  long passes = 1;
+  for_each_filter_type<Model, Kokkos::HostSpace>([&](auto* tag) {
+    using Filter = std::remove_pointer_t<decltype(tag)>;
+    if (std::find(filters.begin(), filters.end(), Filter::name) != filters.end())
+      passes += filter_prepass_passes<Filter>();
+  });
+  return passes * grid.steps;
+}
+
+namespace detail {
+
+/// The pre-passes of the selected filters that have one, in report order: each filter's prepare() runs the
+/// truths with that filter alone as often as it needs. `progress_base` advances by each filter's declared
+/// passes.
+template <class ExecSpace, class Model, class TruthModel>
+typename FilterBank<ExecSpace, Model, TruthModel>::PreparedFilters prepare_filters(
+    const ExecSpace& space, const TruthModel& truth_model, const Model& filter_model, long members,
+    std::uint32_t seed, const TimeGrid& grid, const std::vector<std::string>& filters, const OptionValues& options,
+    const ProgressCallback& progress, long& progress_base) {
+  using Bank = FilterBank<ExecSpace, Model, TruthModel>;
+  using MemSpace = typename ExecSpace::memory_space;
+  typename Bank::PreparedFilters prepared;
+  kushner::for_each_filter_type<Model, MemSpace>([&](auto* tag) {
+    using Filter = std::remove_pointer_t<decltype(tag)>;
+    if constexpr (Filter::unsupported == nullptr && filter_prepass_passes<Filter>() > 0) {
+      if (std::find(filters.begin(), filters.end(), Filter::name) == filters.end()) return;
+      const long start = progress_base;
+      const auto run_alone = [&](const Filter& filter) {
+        typename Bank::PreparedFilters only;
+        std::get<std::optional<Filter>>(only) = filter;
+        Bank bank(space, truth_model, filter_model, members, seed, {Filter::name}, options, only);
+        for (long k = 0; k < grid.steps; ++k) {
+          bank.step(k, grid.dt, false);
+          if (progress) progress(progress_base + k + 1);
+        }
+        progress_base += grid.steps;
+        return bank.members_ok(Filter::name);
+      };
+      std::get<std::optional<Filter>>(prepared) = Filter::prepare(
+          options.with_defaults(filter_options<Filter>()), filter_model, members, run_alone);
+      progress_base = start + filter_prepass_passes<Filter>() * grid.steps;
+    }
+  });
+  return prepared;
+}
+
+}  // namespace detail
+
+/// Runs the filters `filters` (bank filters the model supports, then PF and/or EXACT: drivers/filter_selection.hpp)
+/// over `grid` with the filters' settings `options`, and the `extra` estimators after them (reported after
+/// them, in their order). The truths follow truth_model, the filters filter_model. With PF, EXACT or an extra
+/// estimator, every other estimate is also scored against the reference's mean (rmse_ref): the first of PF,
+/// EXACT, extra[0], ... `progress` counts the steps of all passes (progress_steps).
+template <class ExecSpace, class Model, class TruthModel>
+FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, const Model& filter_model, long members,
+                         std::uint32_t seed, const TimeGrid& grid, const std::vector<std::string>& filters,
+                         const OptionValues& options = {}, const ParticleSettings& particle = {},
+                         const ProgressCallback& progress = {},
+                         const OutputObserver<ExecSpace, Model, TruthModel>& observer = {},
+                         ExtraEstimators<ExecSpace> extra = {}) {
+  using MemSpace = typename ExecSpace::memory_space;
+  FilterReport report;
+  report.filters = filters;
+  std::vector<std::string> bank_filters;
+  std::vector<std::unique_ptr<ReferenceEstimator<MemSpace>>> outside;
+  for (const auto& name : filters) {
+    if (!is_outside_estimator(name)) {
+      bank_filters.push_back(name);
+    } else if (name == particle_filter_name) {
+      if constexpr (particle_filter_unsupported<Model>() == nullptr)
+        outside.push_back(std::make_unique<ParticleReference<ExecSpace, Model>>(space, filter_model, members, seed,
+                                                                                particle));
+    } else if constexpr (has_exact_reference<Model>) {
+      outside.push_back(std::make_unique<ExactReferenceEstimator<ExecSpace, Model>>(space, filter_model, members));
+    }
+  }
+  KUSHNER_REQUIRE(bank_filters.size() + outside.size() == filters.size(),
+                  "run_filters: PF or EXACT named for a model that has none (select_estimators refuses it)");
+  for (auto& e : extra) {
+    KUSHNER_REQUIRE(e && std::find(filters.begin(), filters.end(), e->name()) == filters.end(),
+                    "run_filters: an extra estimator is null or named like a selected one");
+    report.filters.push_back(e->name());
+    outside.push_back(std::move(e));
+  }
+  long progress_base = 0;
+  const auto prepared = detail::prepare_filters(space, truth_model, filter_model, members, seed, grid, bank_filters,
+                                                options, progress, progress_base);
+  FilterBank<ExecSpace, Model, TruthModel> bank(space, truth_model, filter_model, members, seed, bank_filters, options,
+                                                prepared);
+  std::vector<const ReferenceEstimator<MemSpace>*> outside_view;
+  if (!outside.empty()) {
+    bank.set_reference(outside.front().get());  // PF comes before EXACT
+    report.has_reference = true;
+    report.reference = outside.front()->name();
+  }
+  for (auto& e : outside) {
+    bank.add_estimator(e.get());
+    outside_view.push_back(e.get());
+  }
+  auto record = [&](double t) {
+    report.times.push_back(t);
+    report.series.emplace_back();
+    for (const auto& name : report.filters) report.series.back().push_back(bank.snapshot(name));
+    if (observer) observer(t, bank, outside_view);
+  };
+  record(0.0);
+  std::size_t next_output = 1;
+  for (long k = 0; k < grid.steps; ++k) {
+    const bool output = next_output < grid.output_steps.size() && grid.output_steps[next_output] == k + 1;
+    bank.step(k, grid.dt, output);
+    if (output) {
+      record((k + 1) * grid.dt);
+      ++next_output;
+    }
+    if (progress) progress(progress_base + k + 1);
+  }
+  space.fence();
+  for (const auto& name : report.filters) report.scores.push_back(bank.scores(name, grid.steps + 1));
+  for (const auto& name : bank_filters) report.filter_fields[name] = bank.summary_fields(name);
+  for (const auto& e : outside) report.estimators[e->name()] = e->describe();
+  report.truths_escaped = bank.truths_escaped();
+  return report;
+}
+
+}  // namespace kushner

@@ -1,0 +1,108 @@
+#pragma once
+// What a filter of the bank is, in one place. A filter is a struct template Filter<Model, MemSpace> with
+//
+//   static constexpr const char* name, description;  // "QLF", and a line for `kushner filters`
+//   static constexpr const char* unsupported;         // why Model's type rules it out (nullptr: it does not)
+//   static Filter create(const OptionValues&, const Model&, long members);
+//   KOKKOS_INLINE_FUNCTION Status step(const Model&, int member, const StepInput<p>&, Vec<n>& m, Mat<n, n>& P) const;
+//
+// and, where it needs them, these optional parts, which the engine, the command line, `kushner filters` and the
+// summary discover from the filter list (kernels/filters/filter_list.hpp) without naming the filter:
+//
+//   static std::vector<OptionSpec> options();                 // its settings: name, default, range, help
+//   static std::optional<OptionProblem> check(const OptionValues&);  // a setting this Model cannot use
+//   static const char* unsupported_by(const DriftFacts&);     // run-time: coefficients it cannot run
+//   static constexpr int prepass_passes;                      // passes over the horizon before the run, and
+//   template <class RunAlone>                                 // the pre-pass itself: run_alone(filter) runs the
+//   static Filter prepare(const OptionValues&, const Model&, long members, RunAlone&&);  // truths with it alone
+//   Fields summary_fields() const;                            // what it adds to its summary.json entry
+#include "core/fields.hpp"
+#include "core/options.hpp"
+#include "models/drift_facts.hpp"
+#include "models/model_traits.hpp"
+
+#include <optional>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+namespace kushner {
+
+namespace detail {
+template <class Filter, class = void>
+struct has_options : std::false_type {};
+template <class Filter>
+struct has_options<Filter, std::void_t<decltype(Filter::options())>> : std::true_type {};
+
+template <class Filter, class = void>
+struct has_option_check : std::false_type {};
+template <class Filter>
+struct has_option_check<Filter, std::void_t<decltype(Filter::check(std::declval<const OptionValues&>()))>>
+    : std::true_type {};
+
+template <class Filter, class = void>
+struct has_runtime_support : std::false_type {};
+template <class Filter>
+struct has_runtime_support<Filter, std::void_t<decltype(Filter::unsupported_by(std::declval<const DriftFacts&>()))>>
+    : std::true_type {};
+
+template <class Filter, class = void>
+struct has_prepass : std::false_type {};
+template <class Filter>
+struct has_prepass<Filter, std::void_t<decltype(Filter::prepass_passes)>> : std::true_type {};
+
+template <class Filter, class = void>
+struct has_summary_fields : std::false_type {};
+template <class Filter>
+struct has_summary_fields<Filter, std::void_t<decltype(std::declval<const Filter&>().summary_fields())>>
+    : std::true_type {};
+}  // namespace detail
+
+/// The settings Filter declares (empty for most).
+template <class Filter>
+std::vector<OptionSpec> filter_options() {
+  if constexpr (detail::has_options<Filter>::value)
+    return Filter::options();
+  else
+    return {};
+}
+
+/// A setting Filter cannot use with its model, if any.
+template <class Filter>
+std::optional<OptionProblem> check_filter_options(const OptionValues& values) {
+  if constexpr (detail::has_option_check<Filter>::value)
+    return Filter::check(values.with_defaults(filter_options<Filter>()));
+  else
+    return std::nullopt;
+}
+
+/// Why Filter cannot run `model`: its type (Filter::unsupported), then, for a model known only at run time,
+/// its coefficients (Filter::unsupported_by); nullptr when it can.
+template <class Filter, class Model>
+const char* filter_unsupported(const Model& model) {
+  if (Filter::unsupported != nullptr) return Filter::unsupported;
+  if constexpr (ModelTraits<Model>::runtime_checked && detail::has_runtime_support<Filter>::value)
+    return Filter::unsupported_by(model.drift_facts());
+  else
+    return nullptr;
+}
+
+/// How many passes over the horizon Filter's pre-pass takes (0: none).
+template <class Filter>
+constexpr int filter_prepass_passes() {
+  if constexpr (detail::has_prepass<Filter>::value)
+    return Filter::prepass_passes;
+  else
+    return 0;
+}
+
+/// What Filter adds to its entry of summary.json.
+template <class Filter>
+Fields filter_summary_fields(const Filter& filter) {
+  if constexpr (detail::has_summary_fields<Filter>::value)
+    return filter.summary_fields();
+  else
+    return {};
+}
+
+}  // namespace kushner
