@@ -173,3 +173,10 @@ nlohmann::json run_compare_command(const Model& model, const CompareOptions& opt
 }
 
 }  // namespace kushner
+
+/// The explicit instantiations of the filter command for one model (the generated units of drivers/CMakeLists.txt).
+#define KUSHNER_INSTANTIATE_FILTER_COMMAND(Model)                                                                    \
+  template std::vector<std::string> check_compare_options<Model>(const Model&, const CompareOptions&,                \
+                                                                 const OptionValues&);                               \
+  template nlohmann::json run_compare_command<Model>(const Model&, const CompareOptions&, const OptionValues&,       \
+                                                     const TimeGrid&, const RunContext&, const OutputDirectory&);

@@ -72,7 +72,8 @@ struct CarModel : CarBase {
     if (k == 0) h(1, 1) = 2.0 * v / l * math::tan(x[1]) / (c * c);
     return h;
   }
-  /// A(x) = [[0, (v/l) tan(delta) / delta], [0, 0]] (1 at delta = 0), b = (0, u) (/work/notes/filters.md 2.3).
+  /// A(x) = [[0, (v/l) tan(delta) / delta], [0, 0]] (tan(delta) / delta = 1 at delta = 0), b = (0, u): then
+  /// A(x) x + b = ((v/l) tan(delta), u) = f(x).
   KOKKOS_INLINE_FUNCTION SdcDrift<2> sdc_drift(double, const Vec<2>& x) const {
     const double d = x[1];
     const double tan_over = math::fabs(d) < 1e-4 ? 1.0 + d * d / 3.0 : math::tan(d) / d;
@@ -97,7 +98,7 @@ struct CarTaylor3Model : CarBase {
     if (k == 0) h(1, 1) = 2.0 * v / l * x[1];
     return h;
   }
-  /// a0 = (0, u), a1 = [[0, v/l], [0, 0]], a3 = [[0, v/(3l)], [0, 0]] (/work/notes/filters.md 2.4).
+  /// a0 = (0, u), a1 = [[0, v/l], [0, 0]], a3 = [[0, v/(3l)], [0, 0]]: the Taylor drift (v/l)(delta + delta^3/3), u.
   KOKKOS_INLINE_FUNCTION PowerPolynomial<2, 3> drift_power_polynomial(double) const {
     auto poly = PowerPolynomial<2, 3>::zero();
     poly.a0 = Vec<2>{{0.0, u}};

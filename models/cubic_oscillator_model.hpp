@@ -62,7 +62,7 @@ struct CubicOscillatorModel : InitialLaw<2> {
     const double beta = -1.0 + 3.0 / 8.0 * m1 * m1 + 3.0 / 8.0 * p11;
     return {{{m2, -m2 - m1 + m1 * m1 * m1 / 8.0 + 3.0 / 8.0 * p11 * m1}}, {{{0.0, 1.0}, {beta, -1.0}}}};
   }
-  /// f = a1 x + a3 x^3 componentwise: a1 = [[0, 1], [-1, -1]], a3 = [[0, 0], [1/8, 0]] (/work/notes/filters.md 2.2).
+  /// f = a1 x + a3 x^3 componentwise: a1 = [[0, 1], [-1, -1]], a3 = [[0, 0], [1/8, 0]] (f2 = -x2 - x1 + x1^3/8).
   KOKKOS_INLINE_FUNCTION PowerPolynomial<2, 3> drift_power_polynomial(double) const {
     auto poly = PowerPolynomial<2, 3>::zero();
     poly.coefficient[1] = Mat<2, 2>{{{0.0, 1.0}, {-1.0, -1.0}}};

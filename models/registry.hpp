@@ -3,16 +3,9 @@
 // built, its `--set key=value` assignments applied and checked, and f(model) called with the concrete type,
 // so everything downstream is dispatched at compile time.
 #include "core/errors.hpp"
-#include "models/benes_model.hpp"
-#include "models/car_model.hpp"
-#include "models/clark_linear_model.hpp"
-#include "models/cubic_oscillator_model.hpp"
-#include "models/linear_model.hpp"
 #include "models/model_checks.hpp"
-#include "models/ou_model.hpp"
+#include "models/model_list.hpp"
 #include "models/parameters.hpp"
-#include "models/sine_model.hpp"
-#include "models/terpolymer_model.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -23,11 +16,6 @@
 #include <vector>
 
 namespace kushner {
-
-/// Every built-in model; a name may stand for several types told apart by `--set dim=N` (linear).
-using BuiltinModels = std::tuple<OuModel, SineModel, CubicOscillatorModel, LinearModel<1>, LinearModel<2>,
-                                 LinearModel<3>, ClarkLinearModel, CarModel, CarTaylor3Model, TerpolymerModel,
-                                 BenesModel>;
 
 /// Models whose state dimension is chosen on the command line (`--set dim=N`), and its default.
 template <class Model>

@@ -46,7 +46,7 @@ struct SineModel : InitialLaw<1> {
     const double damping = math::exp(-0.5 * P(0, 0));
     return {{{-math::sin(m[0]) * damping}}, {{{-math::cos(m[0]) * damping}}}};
   }
-  /// -sin x = A(x) x with A(x) = -sin(x) / x (-1 at 0): the ASRE factorization (/work/notes/filters.md 2.1).
+  /// -sin x = A(x) x with A(x) = -sin(x) / x (-1 at 0, its limit): the ASRE factorization.
   KOKKOS_INLINE_FUNCTION SdcDrift<1> sdc_drift(double, const Vec<1>& x) const {
     const double v = x[0];
     const double sinc = math::fabs(v) < 1e-4 ? 1.0 - v * v / 6.0 : math::sin(v) / v;

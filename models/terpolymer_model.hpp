@@ -80,7 +80,7 @@ struct TerpolymerModel : InitialLaw<10> {
              -out * x[9] + (K_L1 * c1 + K_L2 * c2) * cs + K_13 * c3 * mp}};
   }
 
-  /// (18) as a0 + a1 x + 32 bilinear terms c x_i x_j (/work/notes/filters.md 2.5): the tensor form of BILIN.
+  /// (18) as a0 + a1 x + 32 bilinear terms c x_i x_j, read off the products in drift(): the tensor form of BILIN.
   KOKKOS_INLINE_FUNCTION QuadraticPolynomial<10, num_bilinear_terms> drift_quadratic_polynomial(double) const {
     QuadraticPolynomial<10, num_bilinear_terms> f;
     const double out = 1.0 / theta;
@@ -155,7 +155,8 @@ struct TerpolymerModel : InitialLaw<10> {
   }
   KOKKOS_INLINE_FUNCTION Mat<10, 10> observation_noise(double) const { return Mat<10, 10>::diagonal(r); }
 
-  /// A(x) x + b with A_ki = a1_ki + sum_j a2_kij x_j (a2 symmetric; /work/notes/filters.md 2.5), b = a0.
+  /// A(x) x + b with A_ki = a1_ki + sum_j a2_kij x_j (a2 symmetric, so each product is split evenly between its
+  /// two variables), b = a0.
   KOKKOS_INLINE_FUNCTION SdcDrift<10> sdc_drift(double t, const Vec<10>& x) const {
     const auto f = drift_quadratic_polynomial(t);
     SdcDrift<10> s{f.a1, f.a0};

@@ -110,7 +110,7 @@ TEST(GridFilter, SineAgreesWithParticleFilterWithinFourMonteCarloStandardErrors)
 }
 
 TEST(GridFilter, CubicOscillatorAgreesWithParticleFilter) {
-  // Inside the well (seed 000's x(0) = (15, 10) escapes to infinity at t ~ 0.34; notes/filters.md 2.2).
+  // Inside the well (seed 000's x(0) = (15, 10) escapes to infinity at t ~ 0.34: models/cubic_oscillator_model.hpp).
   CubicOscillatorModel model;
   model.q = 0.5;
   model.set_initial_law(Vec<2>{{1.0, 0.5}}, Mat<2, 2>::diagonal(0.09));

@@ -2,7 +2,8 @@
 // EKF-DS: the Detchmendy-Sridhar first-order filter, seed 000 Tables 1-2 row [13]: the EKF mean, and the
 // covariance with the extra term 1/2 p^2 h''(m) [y - h(m)] (000 L315), in vector form
 //   dP = (F P + P F^T + W - P H^T V^{-1} H P) dt + 1/2 sum_l P Hess h_l(m) P [V^{-1}(dy - h(m) dt)]_l.
-// The factor 1/2 is the printed one (an invariant-imbedding derivation gives 1; /work/notes/filters.md 1.3).
+// The factor 1/2 is the printed one; an invariant-imbedding derivation of the same filter gives 1. We keep the
+// paper's, since the comparison of Tables 1-2 is what this filter is for.
 // With a linear observation the term vanishes and EKF-DS is the EKF.
 #include "kernels/filters/filter_protocol.hpp"
 #include "kernels/filters/jacobian_linearization.hpp"

@@ -1,6 +1,6 @@
 #pragma once
-// EKF: the first-order filter of Cox, seed 000 Tables 1-2 row [14] (the brief's "[13]": the reference list,
-// 000 L470-471, has [13] = Detchmendy-Sridhar, [14] = Cox; see /work/notes/filters.md section 0.3):
+// EKF: the first-order filter of Cox, seed 000 Tables 1-2 row [14] (the reference list, 000 L470-471, has
+// [13] = Detchmendy-Sridhar and [14] = Cox, whatever a table row label suggests):
 //   dm = f(m) dt + P H(m)^T V^{-1} (dy - h(m) dt),   dP = (F(m) P + P F(m)^T + W - P H^T V^{-1} H P) dt.
 #include "kernels/filters/filter_protocol.hpp"
 #include "kernels/filters/jacobian_linearization.hpp"

@@ -4,7 +4,8 @@
 //   dm = E_N[f] dt + P H0^T V^{-1} (dy - (c0 + H0 m) dt)   with E_N[f] the polynomial filter's mean drift,
 //   dP = (F0 P + P F0^T + W0 - P H0^T V^{-1} H0 P) dt       the KBL covariance (origin linearization).
 // The paper uses it for the bilinear terpolymer model; for componentwise polynomials (cubic oscillator, the
-// car's Taylor model) we take the POLY3/POLY4 mean, the same Gaussian closure (/work/notes/filters.md 1.9).
+// car's Taylor model) we take the POLY3/POLY4 mean: the same Gaussian closure E_N[f], in the form those
+// filters compute it.
 #include "kernels/filters/filter_protocol.hpp"
 #include "kernels/filters/linearized_kalman_bucy_filter.hpp"
 #include "models/model_traits.hpp"

@@ -11,7 +11,8 @@
 // Gaussian prior, which is not itself of the form cosh(x) N(x; a, b)). Given x_0 = z the posterior of x_K
 // is cosh(x) N(x; c(z), s) with c(z) = M_x + S_xz / S_zz (z - M_z), s = S_xx - S_xz^2 / S_zz, whose mean
 // and variance are c + s tanh c and s + s^2 sech^2 c; x_0 has posterior ∝ N(z; M_z, S_zz) cosh(c(z)) /
-// cosh(z), integrated by Gauss-Hermite quadrature. Checked numerically in notes/benes_check.py.
+// cosh(z), integrated by Gauss-Hermite quadrature. tests/test_particle_filter_references.cpp checks it against
+// the particle filter.
 #include "kernels/bank.hpp"
 #include "core/errors.hpp"
 #include "kernels/for_each_member.hpp"
