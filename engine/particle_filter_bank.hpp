@@ -8,7 +8,8 @@
 //   for (long k = 0; k < steps; ++k) { truth.step(k, dt); pf.step(k, dt, truth.observations()); }
 //   pf.posterior_mean();   // (member, i)
 //
-// A step is three stages: propagate + weight + block moments (particle_step.hpp), per-member posterior
+// A step is three stages: propagate + weight + block moments (particle_block_step.hpp on the host,
+// particle_team_step.hpp on GPUs; particle_update.hpp is the per-particle step both share), per-member posterior
 // (particle_posterior.hpp), and resampling of the members whose ESS fell below threshold * N: a team per
 // member (particle_resample_step.hpp), or, with the team kernel and systematic resampling (the GPU's
 // default), many teams per member (chunked_systematic_resample.hpp; the same indices). Every sum that
@@ -25,9 +26,12 @@
 #include "kernels/particle_filter/copy_listed_members.hpp"
 #include "kernels/particle_filter/particle_posterior.hpp"
 #include "kernels/particle_filter/particle_resample_step.hpp"
-#include "kernels/particle_filter/particle_step.hpp"
+#include "kernels/particle_filter/particle_block_step.hpp"
+#include "kernels/particle_filter/particle_team_pair_step.hpp"
+#include "kernels/particle_filter/particle_team_step.hpp"
 #include "kernels/particle_filter/resampling.hpp"
 #include "kernels/particle_filter/resampling_scheme.hpp"
+#include "kernels/particle_filter/tuning.hpp"
 #include "core/eigen_helpers.hpp"
 
 #include <Kokkos_Core.hpp>
@@ -139,7 +143,7 @@ class ParticleFilterBank {
 
   /// Steps k and k + 1 (increments dy, then dy_next): the same results as step(k) then step(k + 1), apart
   /// from the last bits of the sums. With the team kernel and systematic resampling (the GPU's default) the
-  /// particles go through memory once for both steps: ParticleTeamStep<..., 2> reads the bank and writes a
+  /// particles go through memory once for both steps: ParticleTeamPairStep reads the bank and writes a
   /// second one, and the members that step k resamples (whose step k + 1 used the wrong particles) are stepped
   /// again from the untouched first bank: step k, resampling, step k + 1, on the listed members only.
   /// Otherwise it is the two steps. Afterwards the posterior accessors give step k + 1 and first_step()
@@ -164,14 +168,9 @@ class ParticleFilterBank {
                                                 WeightedMoments<state_dim>::size);
     }
     const auto first = static_cast<std::uint32_t>(k), second = first + 1;
-    ParticleStepData<Model, MemSpace> d = step_data(k * dt, dt, first, dy);
-    d.x_out = x_next_;
-    d.log_weight_out = log_weight_next_;
-    d.dy_next = dy_next;
-    d.partials_next = partials_next_;
-    d.observation_precision_next = observation_precision((k + 1) * dt);
-    d.t_next = (k + 1) * dt;
-    run_team_kernel<device_particle_batch, 2>(d);
+    const ParticleSecondStep<Model, MemSpace> next{x_next_, log_weight_next_, dy_next, partials_next_,
+                                                   observation_precision((k + 1) * dt), (k + 1) * dt};
+    run_team_kernel(ParticleTeamPairStep<Model, ExecSpace>{step_data(k * dt, dt, first, dy), next});
     // The pass's output becomes the bank; its input (step k - 1's particles) stays for the redo.
     std::swap(x_, x_next_);
     std::swap(workspace_.cumulative, log_weight_next_);
@@ -183,13 +182,13 @@ class ParticleFilterBank {
     const long copy_items = static_cast<long>(num_members_) * num_particles_;
     copy_listed_members<state_dim>(space_, CopyListedMembers<state_dim, MemSpace>{
         x_next_, x_, log_weight_next_, workspace_.cumulative, resample_list_, resample_list_size_, num_particles_,
-        copy_items < listed_work_items ? copy_items : listed_work_items});
-    run_team_kernel<device_particle_batch, 1, true>(listed(step_data(k * dt, dt, first, dy)));
+        copy_items < listed_copy_items ? copy_items : listed_copy_items});
+    run_team_kernel_listed(ParticleTeamStep<Model, ExecSpace>{step_data(k * dt, dt, first, dy)});
     resample_listed(first_log_normalizer_, first);
-    ParticleStepData<Model, MemSpace> redo = listed(step_data((k + 1) * dt, dt, second, dy_next));
+    ParticleStepData<Model, MemSpace> redo = step_data((k + 1) * dt, dt, second, dy_next);
     redo.log_normalizer = first_log_normalizer_;  // log N after the resampling
     redo.partials = partials_next_;
-    run_team_kernel<device_particle_batch, 1, true>(redo);
+    run_team_kernel_listed(ParticleTeamStep<Model, ExecSpace>{redo});
     // Step k + 1's posterior and resampling, as in step().
     Kokkos::deep_copy(space_, resample_list_size_, 0);
     run_posterior(partials_next_, current_posterior(), log_normalizer_, true);
@@ -243,13 +242,6 @@ class ParticleFilterBank {
                                      << ", " << Model::obs_dim << ")");
   }
 
-  /// d for the members on the resampling list only.
-  ParticleStepData<Model, MemSpace> listed(ParticleStepData<Model, MemSpace> d) const {
-    d.members = resample_list_;
-    d.member_count = resample_list_size_;
-    return d;
-  }
-
   /// (R R^T)^{-1} at t.
   Mat<Model::obs_dim, Model::obs_dim> observation_precision(double t) const {
     constexpr int p = Model::obs_dim;
@@ -286,7 +278,7 @@ class ParticleFilterBank {
   void run_step_kernels(const ParticleStepData<Model, MemSpace>& d) {
     constexpr int n = state_dim;
     if (use_team_) {
-      run_team_kernel<device_particle_batch>(d);
+      run_team_kernel(ParticleTeamStep<Model, ExecSpace>{d});
     } else {
       run_host_block_kernel(d);
     }
@@ -350,27 +342,37 @@ class ParticleFilterBank {
     first_log_normalizer_ = BankScalar<double, MemSpace>("kushner::log_normalizer_first", num_members_);
   }
 
-  /// The team kernel: a team per (chunk, member), or (Listed) a fixed league over the chunks of the members
-  /// in d.members. Launched with its arguments as kernel parameters (Kokkos' light-weight hint): the functor
-  /// is over the 512 bytes below which Kokkos does that by default, and copies larger ones to constant memory
-  /// first.
-  template <int Batch, int Steps = 1, bool Listed = false>
-  void run_team_kernel(const ParticleStepData<Model, MemSpace>& d) {
-    using Kernel = ParticleTeamStep<Model, ExecSpace, Batch, Steps, Listed>;
-    using LightWeight = Kokkos::Experimental::WorkItemProperty::HintLightWeight_t;
+  /// A team kernel (ParticleTeamStep, ParticleTeamPairStep) over every (chunk, member), a team each.
+  template <class Kernel>
+  void run_team_kernel(const Kernel& kernel) {
+    launch_team_kernel<Kernel>(static_cast<long>(num_blocks_) * num_members_, EveryMemberChunk<Kernel>{kernel, num_blocks_});
+  }
+
+  /// ... over the chunks of the members on the resampling list only: a fixed league loops over them.
+  template <class Kernel>
+  void run_team_kernel_listed(const Kernel& kernel) {
     const long items = static_cast<long>(num_blocks_) * num_members_;
-    const int league = static_cast<int>(!Listed || items < listed_league ? items : listed_league);
-    if (team_size_ == device_particle_team) {  // measured best on an H100: 4 teams (64 registers) per SM
+    launch_team_kernel<Kernel>(items < listed_team_league ? items : listed_team_league,
+                               ListedMemberChunks<Kernel>{kernel, resample_list_, resample_list_size_, num_blocks_});
+  }
+
+  /// Launched with its arguments as kernel parameters (Kokkos' light-weight hint): the functor is over the 512
+  /// bytes below which Kokkos does that by default, and copies larger ones to constant memory first. At the
+  /// default team size, with the launch bound of tuning.hpp.
+  template <class Kernel, class Launcher>
+  void launch_team_kernel(long league, const Launcher& launcher) {
+    using LightWeight = Kokkos::Experimental::WorkItemProperty::HintLightWeight_t;
+    if (team_size_ == device_particle_team) {
       Kokkos::TeamPolicy<ExecSpace, Kokkos::LaunchBounds<device_particle_team, device_particle_teams_per_sm>,
                          LightWeight>
-          policy(space_, league, team_size_);
+          policy(space_, static_cast<int>(league), team_size_);
       policy.set_scratch_size(0, Kokkos::PerTeam(Kernel::scratch_bytes(team_size_)));
-      Kokkos::parallel_for("kushner::particle_team_step", policy, Kernel{d, num_blocks_});
+      Kokkos::parallel_for("kushner::particle_team_step", policy, launcher);
       return;
     }
-    Kokkos::TeamPolicy<ExecSpace, LightWeight> policy(space_, league, team_size_);
+    Kokkos::TeamPolicy<ExecSpace, LightWeight> policy(space_, static_cast<int>(league), team_size_);
     policy.set_scratch_size(0, Kokkos::PerTeam(Kernel::scratch_bytes(team_size_)));
-    Kokkos::parallel_for("kushner::particle_team_step", policy, Kernel{d, num_blocks_});
+    Kokkos::parallel_for("kushner::particle_team_step", policy, launcher);
   }
 
   void run_host_block_kernel(const ParticleStepData<Model, MemSpace>& d) {
@@ -388,9 +390,6 @@ class ParticleFilterBank {
   int num_members_, num_particles_;
   bool use_team_ = false;
   int block_size_ = 0, num_blocks_ = 0, team_size_ = 1;
-  // Fixed leagues of the kernels that loop over the listed members (their number stays on the device).
-  static constexpr int listed_league = 1024;
-  static constexpr long listed_work_items = 1L << 18;
   ParticleBank<MemSpace> x_, x_scratch_;
   ResamplingWorkspace<MemSpace> workspace_;
   // step_pair: the second bank, the second step's partials, step k's posterior.

@@ -4,15 +4,14 @@
 // sequentially, the block sums are prefixed sequentially, then each block is prefixed sequentially from its
 // offset. So the cumulative weights -- and the resampled indices -- are the same bits on CPU and GPU.
 // (A tree-ordered parallel_scan would round differently on each backend.)
+#include "kernels/particle_filter/tuning.hpp"
+
 #include <Kokkos_Core.hpp>
 
 namespace kushner {
 
 /// At most this many blocks per column: their sums live in team scratch memory (32 KiB of doubles).
 constexpr int max_scan_blocks = 4096;
-
-/// Entries a thread loads at once in the scan's sequential loops.
-constexpr int scan_batch = 16;
 
 /// Entries per block: 256, or more when the column has more than 256 * max_scan_blocks entries.
 KOKKOS_INLINE_FUNCTION constexpr int scan_block_size(int n) {

@@ -1,7 +1,7 @@
 #pragma once
 // Systematic resampling of the members that need it, spread over many teams per member: the particle
-// filter's resampling path on GPUs. A member of 65536 particles resampled by one team (one multiprocessor)
-// kept the rest of the GPU idle for ~0.2 ms per step; here every chunk of particles of every listed member is
+// filter's resampling path on GPUs. A member resampled by one team (one multiprocessor) leaves the rest of the
+// GPU idle (perf/particle_filter.md, "Resampling"); here every chunk of particles of every listed member is
 // a work item, in four kernels:
 //   1. block sums:  w_j = exp(l_j - log_normalizer) summed sequentially over each scan block
 //   2. cumulative:  each block's cumulative weights C_j, from the prefix of the block sums, over the
@@ -10,7 +10,7 @@
 //                   g(C) = ceil(N C / C_{N-1} - u)
 //   4. copy back:   the resampled particles return to the bank, with equal weights
 // Every thread's sequential chain is at most one scan block long (or the block sums before it, read from team
-// scratch): a first version recomputed whole blocks of exp() in one thread and spent 0.1 ms per step there.
+// scratch), so no thread recomputes whole blocks of exp() alone.
 // The kernels are latency-bound (a step resamples one or two members of a thousand), so each thread issues
 // the loads of its share of a chunk together: one memory latency per chunk, not one per particle.
 // The sums are the ones blocked_inclusive_scan and resample_member compute (same blocks, same sequential
@@ -21,18 +21,13 @@
 #include "core/math.hpp"
 #include "kernels/particle_filter/blocked_scan.hpp"
 #include "kernels/particle_filter/resampling.hpp"
+#include "kernels/particle_filter/tuning.hpp"
 
 #include <Kokkos_Core.hpp>
 
 #include <cstdint>
 
 namespace kushner {
-
-/// Particles of a work item: whole scan blocks, at most this many (their weights live in team scratch).
-constexpr int resample_chunk_particles = 2048;
-
-/// Particles a thread loads at once: a chunk of 2048 is 8 per thread of a 256-thread team.
-constexpr int resample_batch = 8;
 
 /// Whether the chunked path handles members of n particles: its chunks hold whole scan blocks.
 KOKKOS_INLINE_FUNCTION constexpr bool chunked_resample_supports(int n) {

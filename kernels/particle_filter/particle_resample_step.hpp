@@ -6,6 +6,7 @@
 #include "kernels/bank.hpp"
 #include "core/math.hpp"
 #include "kernels/particle_filter/resampling.hpp"
+#include "kernels/particle_filter/tuning.hpp"
 
 #include <Kokkos_Core.hpp>
 
@@ -33,7 +34,7 @@ struct ParticleResampleStep {
     const double log_total = log_normalizer(member);
     // Each thread handles `batch` particles at a time, strided by the team size, with every load of a batch
     // issued before its stores: these loops are latency-bound on a GPU (one team per resampled member).
-    constexpr int batch = 8;
+    constexpr int batch = resample_step_batch;
     const int threads = team.team_size(), rank = team.team_rank();
     for (int j0 = rank; j0 < n; j0 += batch * threads) {
       double l[batch];

@@ -1,0 +1,135 @@
+#pragma once
+// The host's particle step: propagate + weight + moments for a block of host_particle_block particles of one
+// member, with `#pragma omp simd` loops over particle-contiguous arrays (GCC does not vectorize a Kokkos range
+// loop). Each (block, member) is a work item of a range loop; the block's WeightedMoments go to d.partials.
+#include "kernels/for_each_member.hpp"
+#include "kernels/particle_filter/particle_update.hpp"
+#include "kernels/particle_filter/tuning.hpp"
+#include "kernels/vector_math.hpp"
+
+#include <Kokkos_Core.hpp>
+
+#include <cstdint>
+
+// `#pragma omp simd` where GCC honours it (-fopenmp or -fopenmp-simd); nothing elsewhere (nvcc's host pass).
+#define KUSHNER_PRAGMA(x) _Pragma(#x)
+#if defined(_OPENMP) || defined(KUSHNER_VECTOR_MATH)
+#define KUSHNER_SIMD KUSHNER_PRAGMA(omp simd)
+#define KUSHNER_SIMD_REDUCTION(...) KUSHNER_PRAGMA(omp simd reduction(__VA_ARGS__))
+#else
+#define KUSHNER_SIMD
+#define KUSHNER_SIMD_REDUCTION(...)
+#endif
+
+namespace kushner {
+
+/// The host kernel's work for one block: a function of the model and the data only (not of the execution
+/// space), so Serial and OpenMP run the same machine code and give the same bits (kernels/for_each_member.hpp).
+template <bool Initialize, class Model>
+KUSHNER_SAME_CODE_FOR_ALL_CALLERS void particle_block_host(const ParticleStepData<Model, Kokkos::HostSpace>& d,
+                                                           int member, int block) {
+  constexpr int n = Model::state_dim;
+  constexpr int B = host_particle_block;
+  const int begin = block * B;
+  const int count = d.num_particles - begin < B ? d.num_particles - begin : B;
+  double* xs[n];
+  for (int i = 0; i < n; ++i) xs[i] = &d.x(begin, member, i);
+  double* lw = &d.log_weight(begin, member);
+  const double log_normalizer = d.initialize ? 0.0 : d.log_normalizer(member);
+  const Vec<Model::obs_dim> vinv_dy = d.initialize ? Vec<Model::obs_dim>::zero() : precision_times_dy(d, member);
+  double l[B], e[B], dx[n][B];
+  // The block's draws first, pair by pair, into particle-contiguous arrays that the particle loop reads.
+  constexpr int K = particle_draw_dim<Model, Initialize>;
+  double z[K][B], u[B];
+  const RngKey key = particle_draw_key<Initialize>(d);
+  const std::uint32_t step = particle_draw_step<Initialize>(d);
+  const int first_pair = begin / 2;   // blocks start at even particles
+  const int pairs = (count + 1) / 2;  // an odd count's last particle is the even half of its pair
+  for (int i = 0; i < K; ++i) {
+    KUSHNER_SIMD
+    for (int k = 0; k < pairs; ++k) {
+      const NormalPair zk = pair_normals<SimdDraws>(key, member, first_pair + k, step, i);
+      z[i][2 * k] = zk.z0;
+      z[i][2 * k + 1] = zk.z1;
+    }
+  }
+  if constexpr (draws_uniform<Model, Initialize>) {
+    KUSHNER_SIMD
+    for (int k = 0; k < pairs; ++k) {
+      double u0, u1;
+      pair_uniforms<SimdDraws>(key, member, first_pair + k, step, K, u0, u1);
+      u[2 * k] = u0;
+      u[2 * k + 1] = u1;
+    }
+  }
+KUSHNER_SIMD
+  for (int j = 0; j < count; ++j) {
+    Vec<n> xj;
+    Vec<K> zj;
+    KUSHNER_UNROLL_FULLY
+    for (int i = 0; i < n; ++i) xj[i] = xs[i][j];
+    KUSHNER_UNROLL_FULLY
+    for (int i = 0; i < K; ++i) zj[i] = z[i][j];
+    const double uj = draws_uniform<Model, Initialize> ? u[j] : 0.0;
+    const double lj =
+        update_particle<Initialize>(d, d.t, d.observation_precision, zj, uj, lw[j], log_normalizer, vinv_dy, xj);
+    KUSHNER_UNROLL_FULLY
+    for (int i = 0; i < n; ++i) xs[i][j] = xj[i];
+    lw[j] = lj;
+    l[j] = lj;
+  }
+  double m = -positive_infinity();
+KUSHNER_SIMD_REDUCTION(max : m)
+  for (int j = 0; j < count; ++j) m = l[j] > m ? l[j] : m;
+
+  WeightedMoments<n> w = WeightedMoments<n>::empty();
+  if (m > -positive_infinity()) {
+    const Vec<n> ref = load<n>(d.reference, member);
+    w.max_log_weight = m;
+KUSHNER_SIMD
+    for (int j = 0; j < count; ++j) {
+      e[j] = math::exp(l[j] - m);
+      KUSHNER_UNROLL_FULLY
+      for (int i = 0; i < n; ++i) dx[i][j] = e[j] > 0.0 ? xs[i][j] - ref[i] : 0.0;
+    }
+    double s = 0.0, s2 = 0.0;
+KUSHNER_SIMD_REDUCTION(+ : s, s2)
+    for (int j = 0; j < count; ++j) {
+      s += e[j];
+      s2 += e[j] * e[j];
+    }
+    w.sum_weight = s;
+    w.sum_weight_sq = s2;
+    for (int i = 0; i < n; ++i) {
+      double sx = 0.0;
+KUSHNER_SIMD_REDUCTION(+ : sx)
+      for (int j = 0; j < count; ++j) sx += e[j] * dx[i][j];
+      w.sum_dx[i] = sx;
+      for (int k = i; k < n; ++k) {
+        double sxx = 0.0;
+KUSHNER_SIMD_REDUCTION(+ : sxx)
+        for (int j = 0; j < count; ++j) sxx += e[j] * dx[i][j] * dx[k][j];
+        w.sum_dxdx[packed_index(n, i, k)] = sxx;
+      }
+    }
+  }
+  w.store(d.partials, block, member);
+}
+
+/// Host kernel: one work item per (block, member).
+template <class Model>
+struct ParticleBlockStep {
+  ParticleStepData<Model, Kokkos::HostSpace> d;
+  int blocks_per_member;
+  void operator()(const int item) const {
+    const int member = item / blocks_per_member, block = item % blocks_per_member;
+    if (d.status(member) != Status::ok) {
+      WeightedMoments<Model::state_dim>::empty().store(d.partials, block, member);
+      return;
+    }
+    if (d.initialize) particle_block_host<true>(d, member, block);
+    else particle_block_host<false>(d, member, block);
+  }
+};
+
+}  // namespace kushner

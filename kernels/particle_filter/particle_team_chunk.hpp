@@ -1,0 +1,117 @@
+#pragma once
+// What the GPU's team kernels (particle_team_step.hpp: one step; particle_team_pair_step.hpp: two steps fused)
+// share: a team takes one chunk of one member's particles; each thread takes pairs of particles (which share
+// their Philox blocks) in batches, loading a whole batch before it computes; the team's moments are summed as
+// e = exp(l - s) with one shift s per member and step (no running maximum: one exp per particle, and the
+// threads' sums add without rescaling), checked afterwards against the team's largest l. Which members and
+// chunks the league covers is the launcher's choice: every (member, chunk), or the listed members only.
+#include "kernels/particle_filter/particle_update.hpp"
+#include "kernels/particle_filter/team_reduction.hpp"
+#include "kernels/particle_filter/tuning.hpp"
+
+#include <Kokkos_Core.hpp>
+
+namespace kushner {
+
+/// Where the team's sums are too far from their shift (particles far from the observation, an extreme dy)
+/// they could under- or overflow. Within 200 of the shift a square is at most e^400 ~ 5e173, so sums of
+/// squares of any int-counted number of particles stay finite.
+constexpr double team_max_shift_gap = 200.0;
+
+/// Particle pairs per batch of a thread.
+constexpr int device_pairs_per_batch = (device_particle_batch + 1) / 2;
+
+/// The particles [begin, end) of a team's chunk, and the thread's place in the team.
+struct ParticleChunk {
+  int begin, end, rank, threads;
+};
+template <class Team>
+KOKKOS_INLINE_FUNCTION ParticleChunk particle_chunk(const Team& team, int chunk, int block_size, int num_particles) {
+  const int begin = chunk * block_size;
+  const int end = begin + block_size < num_particles ? begin + block_size : num_particles;
+  return {begin, end, team.team_rank(), team.team_size()};
+}
+
+/// Slot k of the batch that starts at pair `base` holds particle 2 (base + (k / 2) threads) + k % 2: a thread's
+/// pairs are strided by the team size, so a warp's loads are contiguous.
+KOKKOS_INLINE_FUNCTION int batch_particle(int base, int k, int threads) { return 2 * (base + (k / 2) * threads) + k % 2; }
+
+/// Loads the batch's particles (and log-weights, unless initializing) from one member's columns: xm[j + i * stride]
+/// and lwm[j]. Slots past `end` are left as they are.
+template <int N, bool Initialize>
+KOKKOS_INLINE_FUNCTION void load_particle_batch(const double* xm, const double* lwm, std::size_t stride, int base,
+                                                int threads, int end, Vec<N>* x, double* lw) {
+  KUSHNER_DEVICE_UNROLL
+  for (int k = 0; k < 2 * device_pairs_per_batch; ++k) {
+    const int j = batch_particle(base, k, threads);
+    if (j < end) {
+      KUSHNER_DEVICE_UNROLL
+      for (int i = 0; i < N; ++i) x[k][i] = xm[j + i * stride];
+      lw[k] = Initialize ? 0.0 : lwm[j];
+    }
+  }
+}
+
+/// The batch's draws at `step`.
+template <class Model, bool Initialize>
+KOKKOS_INLINE_FUNCTION void draw_particle_batch(const RngKey& key, int member, int base, int threads,
+                                                std::uint32_t step, Vec<particle_draw_dim<Model, Initialize>>* z,
+                                                double* u) {
+  KUSHNER_DEVICE_UNROLL
+  for (int b = 0; b < device_pairs_per_batch; ++b)
+    draw_particle_pair<Model, Initialize>(key, member, base + b * threads, step, z[2 * b], z[2 * b + 1], u[2 * b],
+                                          u[2 * b + 1]);
+}
+
+/// Adds a particle of log-weight l - shift; weight zero adds nothing (its x may not be finite).
+template <int N>
+KOKKOS_INLINE_FUNCTION void add_shifted_particle(double shifted, const Vec<N>& dx, WeightedMoments<N>& w) {
+  const double e = math::exp(shifted);
+  if (e > 0.0) w.add_weight(e, dx);
+}
+
+/// The team's moments of one step: w holds the thread's sums relative to `shift` and (in max_log_weight) its
+/// largest l. Afterwards every thread holds the team's sums relative to the returned shift in w. Where the
+/// team's largest l is more than team_max_shift_gap from `shift` (rare, and the same for the whole team), the
+/// team sums again relative to its largest l: resum(shift, w) adds the thread's particles to an empty w.
+template <int N, class Team, class Scratch, class Resum>
+KOKKOS_INLINE_FUNCTION void team_moments_at_shift(const Team& team, const Scratch& buffer, double shift,
+                                                  WeightedMoments<N>& w, const Resum& resum) {
+  team_sum(team, buffer, w);
+  if (!(w.max_log_weight > -positive_infinity())) return;  // every particle of the chunk has weight zero
+  const double gap = w.max_log_weight - shift;
+  if (!(gap >= -team_max_shift_gap && gap <= team_max_shift_gap)) {
+    shift = w.max_log_weight;
+    w = WeightedMoments<N>::empty();
+    resum(shift, w);
+    team_sum(team, buffer, w);
+  }
+  w.max_log_weight = shift;
+}
+
+/// Launches a team kernel's step_chunk(team, member, chunk) over every (member, chunk): a team each.
+template <class Kernel>
+struct EveryMemberChunk {
+  Kernel kernel;
+  int chunks_per_member;
+  KOKKOS_INLINE_FUNCTION void operator()(const typename Kernel::Team& team) const {
+    kernel.step_chunk(team, team.league_rank() / chunks_per_member, team.league_rank() % chunks_per_member);
+  }
+};
+
+/// ... over the chunks of members(0 .. member_count() - 1) only: a fixed league loops over them (how many
+/// members are listed stays on the device). A separate instantiation: the loop costs registers.
+template <class Kernel>
+struct ListedMemberChunks {
+  Kernel kernel;
+  Kokkos::View<const int*, typename Kernel::MemSpace> members;
+  Kokkos::View<const int, typename Kernel::MemSpace> member_count;
+  int chunks_per_member;
+  KOKKOS_INLINE_FUNCTION void operator()(const typename Kernel::Team& team) const {
+    const int items = member_count() * chunks_per_member;
+    for (int item = team.league_rank(); item < items; item += team.league_size())
+      kernel.step_chunk(team, members(item / chunks_per_member), item % chunks_per_member);
+  }
+};
+
+}  // namespace kushner

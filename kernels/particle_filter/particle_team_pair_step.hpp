@@ -1,0 +1,129 @@
+#pragma once
+// Two particle steps (k and k + 1) fused into one pass of the GPU's team kernel: the particles stay in
+// registers between the steps, so a particle-step moves half the bytes (the step is bound by the GPU's power
+// limit, of which memory traffic is a large part). The pass reads d.x and d.log_weight and writes next.x and
+// next.log_weight, so its first step can be redone from untouched inputs. Step k + 1's log-weights are left
+// normalized by step k - 1's normalizer (step k's is not known yet): its shift is the sum of both steps'
+// bounds, and both steps' moments are taken relative to the same reference point.
+// ParticleFilterBank::step_pair redoes the members that step k resamples.
+#include "kernels/particle_filter/particle_team_chunk.hpp"
+
+#include <Kokkos_Core.hpp>
+
+namespace kushner {
+
+template <class Model, class ExecSpace>
+struct ParticleTeamPairStep {
+  using MemSpace = typename ExecSpace::memory_space;
+  using Team = typename Kokkos::TeamPolicy<ExecSpace>::member_type;
+  using Scratch = Kokkos::View<double*, typename ExecSpace::scratch_memory_space, Kokkos::MemoryUnmanaged>;
+  static constexpr int n = Model::state_dim, p = Model::obs_dim;
+  ParticleStepData<Model, MemSpace> d;  // step k: its inputs, increments and partials
+  ParticleSecondStep<Model, MemSpace> next;  // step k + 1: its outputs, increments and partials
+
+  static std::size_t scratch_bytes(int team_size) { return team_sum_scratch_bytes<n>(team_size); }
+
+  KOKKOS_INLINE_FUNCTION void step_chunk(const Team& team, int member, int chunk) const {
+    const ParticleChunk c = particle_chunk(team, chunk, d.block_size, d.num_particles);
+    const Scratch buffer(team.team_scratch(0), WeightedMoments<n>::size * (c.threads + 1));
+    WeightedMoments<n> w[2] = {WeightedMoments<n>::empty(), WeightedMoments<n>::empty()};
+    double shift[2] = {0.0, 0.0};
+    Vec<p> vinv_dy[2] = {Vec<p>::zero(), Vec<p>::zero()};
+    Vec<n> ref = Vec<n>::zero();
+    if (d.status(member) == Status::ok) {
+      ref = load<n>(d.reference, member);
+      double bound = 0.0;
+      KUSHNER_DEVICE_UNROLL
+      for (int s = 0; s < 2; ++s) {
+        const Vec<p> dy = load<p>(s == 0 ? d.dy : next.dy, member);
+        vinv_dy[s] = precision(s) * dy;
+        bound += log_weight_bound(dy, vinv_dy[s], d.dt);
+        shift[s] = bound;
+      }
+      step_particles(member, c, ref, vinv_dy, shift, w);
+    }
+    // Step k's resum recomputes it from the pass's inputs; step k + 1's reads the values just stored.
+    team_moments_at_shift(team, buffer, shift[0], w[0],
+                          [&](double s, WeightedMoments<n>& v) { resum_first_step(member, c, ref, vinv_dy[0], s, v); });
+    if (c.rank == 0) w[0].store(d.partials, chunk, member);
+    team_moments_at_shift(team, buffer, shift[1], w[1], [&](double s, WeightedMoments<n>& v) {
+      for (int j = c.begin + c.rank; j < c.end; j += c.threads)
+        add_shifted_particle(next.log_weight(j, member) - s, load_particle<n>(next.x, j, member) - ref, v);
+    });
+    if (c.rank == 0) w[1].store(next.partials, chunk, member);
+  }
+
+ private:
+  /// Step s of the pass: its start time and V^{-1} there.
+  KOKKOS_INLINE_FUNCTION double step_time(int s) const { return s == 0 ? d.t : next.t; }
+  KOKKOS_INLINE_FUNCTION const Mat<p, p>& precision(int s) const {
+    return s == 0 ? d.observation_precision : next.observation_precision;
+  }
+
+  /// As ParticleTeamStep::step_particles, for both steps: a batch is loaded once, stepped twice, stored once.
+  KOKKOS_INLINE_FUNCTION void step_particles(int member, const ParticleChunk& c, const Vec<n>& ref,
+                                             const Vec<p>* vinv_dy, const double* shift,
+                                             WeightedMoments<n>* w) const {
+    constexpr int B = 2 * device_pairs_per_batch;
+    constexpr int K = particle_draw_dim<Model, false>;
+    const double log_normalizer = d.log_normalizer(member);
+    double top[2] = {-positive_infinity(), -positive_infinity()};
+    const double* const xm = &d.x(0, member, 0);
+    const double* const lwm = &d.log_weight(0, member);
+    double* const xo = &next.x(0, member, 0);
+    double* const lwo = &next.log_weight(0, member);
+    const std::size_t stride = d.x.stride_2();  // the same for next.x
+    const RngKey key = particle_draw_key<false>(d);
+    for (int base = c.begin / 2 + c.rank; base < (c.end + 1) / 2; base += device_pairs_per_batch * c.threads) {
+      Vec<n> x[B];
+      double lw[B];
+      load_particle_batch<n, false>(xm, lwm, stride, base, c.threads, c.end, x, lw);
+      KUSHNER_DEVICE_UNROLL
+      for (int s = 0; s < 2; ++s) {
+        Vec<K> z[B];
+        double u[B];
+        draw_particle_batch<Model, false>(key, member, base, c.threads, d.step + s, z, u);
+        KUSHNER_DEVICE_UNROLL
+        for (int k = 0; k < B; ++k) {
+          const int j = batch_particle(base, k, c.threads);
+          if (j >= c.end) continue;
+          const double l = update_particle<false>(d, step_time(s), precision(s), z[k], u[k], lw[k],
+                                                  s == 0 ? log_normalizer : 0.0, vinv_dy[s], x[k]);
+          if (s == 1) {
+            KUSHNER_DEVICE_UNROLL
+            for (int i = 0; i < n; ++i) xo[j + i * stride] = x[k][i];
+            lwo[j] = l;
+          }
+          lw[k] = l;
+          top[s] = l > top[s] ? l : top[s];
+          add_shifted_particle(l - shift[s], x[k] - ref, w[s]);
+        }
+      }
+    }
+    w[0].max_log_weight = top[0];
+    w[1].max_log_weight = top[1];
+  }
+
+  /// Step k again for the thread's particles, from the pass's inputs, summed relative to `shift`.
+  KOKKOS_INLINE_FUNCTION void resum_first_step(int member, const ParticleChunk& c, const Vec<n>& ref,
+                                               const Vec<p>& vinv_dy, double shift, WeightedMoments<n>& w) const {
+    constexpr int K = particle_draw_dim<Model, false>;
+    const double log_normalizer = d.log_normalizer(member);
+    const RngKey key = particle_draw_key<false>(d);
+    for (int pair = c.begin / 2 + c.rank; pair < (c.end + 1) / 2; pair += c.threads) {
+      Vec<K> z[2];
+      double u[2];
+      draw_particle_pair<Model, false>(key, member, pair, d.step, z[0], z[1], u[0], u[1]);
+      for (int k = 0; k < 2; ++k) {
+        const int j = 2 * pair + k;
+        if (j >= c.end) continue;
+        Vec<n> x = load_particle<n>(d.x, j, member);
+        const double l = update_particle<false>(d, d.t, d.observation_precision, z[k], u[k], d.log_weight(j, member),
+                                                log_normalizer, vinv_dy, x);
+        add_shifted_particle(l - shift, x - ref, w);
+      }
+    }
+  }
+};
+
+}  // namespace kushner

@@ -1,0 +1,85 @@
+#pragma once
+// The GPU's particle step: a team per (chunk, member) propagates and weights its particles (update_particle)
+// and reduces them to the chunk's WeightedMoments in d.partials (particle_team_chunk.hpp has the batches and
+// the shifted sums). Also runs on host spaces, where the tests compare it with the host's block kernel.
+#include "kernels/particle_filter/particle_team_chunk.hpp"
+
+#include <Kokkos_Core.hpp>
+
+namespace kushner {
+
+template <class Model, class ExecSpace>
+struct ParticleTeamStep {
+  using MemSpace = typename ExecSpace::memory_space;
+  using Team = typename Kokkos::TeamPolicy<ExecSpace>::member_type;
+  using Scratch = Kokkos::View<double*, typename ExecSpace::scratch_memory_space, Kokkos::MemoryUnmanaged>;
+  static constexpr int n = Model::state_dim, p = Model::obs_dim;
+  ParticleStepData<Model, MemSpace> d;
+
+  static std::size_t scratch_bytes(int team_size) { return team_sum_scratch_bytes<n>(team_size); }
+
+  KOKKOS_INLINE_FUNCTION void step_chunk(const Team& team, int member, int chunk) const {
+    const ParticleChunk c = particle_chunk(team, chunk, d.block_size, d.num_particles);
+    const Scratch buffer(team.team_scratch(0), WeightedMoments<n>::size * (c.threads + 1));
+    WeightedMoments<n> w = WeightedMoments<n>::empty();  // sums relative to `shift`; max_log_weight: largest l
+    double shift = 0.0;
+    Vec<n> ref = Vec<n>::zero();
+    if (d.status(member) == Status::ok) {
+      ref = load<n>(d.reference, member);
+      if (d.initialize) {
+        step_particles<true>(member, c, ref, Vec<p>::zero(), shift, w);
+      } else {
+        const Vec<p> dy = load<p>(d.dy, member);
+        const Vec<p> vinv_dy = d.observation_precision * dy;
+        shift = log_weight_bound(dy, vinv_dy, d.dt);
+        step_particles<false>(member, c, ref, vinv_dy, shift, w);
+      }
+    }
+    team_moments_at_shift(team, buffer, shift, w, [&](double s, WeightedMoments<n>& v) {
+      for (int j = c.begin + c.rank; j < c.end; j += c.threads)
+        add_shifted_particle(d.log_weight(j, member) - s, load_particle<n>(d.x, j, member) - ref, v);
+    });
+    if (c.rank == 0) w.store(d.partials, chunk, member);
+  }
+
+ private:
+  /// The thread's pairs of the chunk, device_pairs_per_batch at a time: a batch's loads are issued first and
+  /// its draws computed next (they need no memory), so the draws run while the loads are in flight.
+  template <bool Initialize>
+  KOKKOS_INLINE_FUNCTION void step_particles(int member, const ParticleChunk& c, const Vec<n>& ref,
+                                             const Vec<p>& vinv_dy, double shift, WeightedMoments<n>& w) const {
+    constexpr int B = 2 * device_pairs_per_batch;  // particles per batch
+    constexpr int K = particle_draw_dim<Model, Initialize>;
+    const double log_normalizer = Initialize ? 0.0 : d.log_normalizer(member);
+    double top = -positive_infinity();
+    // The member's columns as pointers: one 64-bit address computation per thread, not per access.
+    double* const xm = &d.x(0, member, 0);
+    double* const lwm = &d.log_weight(0, member);
+    const std::size_t stride = d.x.stride_2();  // LayoutLeft: x(j, member, i) = xm[j + i * stride]
+    const RngKey key = particle_draw_key<Initialize>(d);
+    const std::uint32_t step = particle_draw_step<Initialize>(d);
+    for (int base = c.begin / 2 + c.rank; base < (c.end + 1) / 2; base += device_pairs_per_batch * c.threads) {
+      Vec<n> x[B];
+      double lw[B];
+      load_particle_batch<n, Initialize>(xm, lwm, stride, base, c.threads, c.end, x, lw);
+      Vec<K> z[B];
+      double u[B];
+      draw_particle_batch<Model, Initialize>(key, member, base, c.threads, step, z, u);
+      KUSHNER_DEVICE_UNROLL
+      for (int k = 0; k < B; ++k) {
+        const int j = batch_particle(base, k, c.threads);
+        if (j >= c.end) continue;
+        const double l = update_particle<Initialize>(d, d.t, d.observation_precision, z[k], u[k], lw[k],
+                                                     log_normalizer, vinv_dy, x[k]);
+        KUSHNER_DEVICE_UNROLL
+        for (int i = 0; i < n; ++i) xm[j + i * stride] = x[k][i];
+        lwm[j] = l;
+        top = l > top ? l : top;
+        add_shifted_particle(l - shift, x[k] - ref, w);
+      }
+    }
+    w.max_log_weight = top;
+  }
+};
+
+}  // namespace kushner

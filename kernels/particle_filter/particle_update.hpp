@@ -1,0 +1,142 @@
+#pragma once
+// One particle's step of the bootstrap particle filter (Gordon, Salmond & Smith 1993; continuous-time
+// observations as in Bain & Crisan 2009, ch. 9): propagate with the model's Euler-Maruyama step (or its exact
+// transition), then multiply the weight by the likelihood of the member's observation increment,
+//   log g(dy | x) = h(x)^T V^{-1} dy - (dt / 2) h(x)^T V^{-1} h(x) + const,   V = R R^T,
+// which is -|dy - h dt|^2_{(V dt)^{-1}} / 2 up to a constant of the member. Every step kernel (the host's
+// block kernel, the GPU's one-step and fused two-step team kernels) calls update_particle, with the draws
+// of particle_draws.hpp.
+#include "core/linear_algebra.hpp"
+#include "core/math.hpp"
+#include "core/portability.hpp"
+#include "core/status.hpp"
+#include "kernels/bank.hpp"
+#include "kernels/particle_filter/particle_draws.hpp"
+#include "kernels/particle_filter/particle_model_traits.hpp"
+#include "kernels/particle_filter/simd_random.hpp"
+#include "kernels/particle_filter/weighted_moments.hpp"
+#include "kernels/rng.hpp"
+
+#include <Kokkos_Core.hpp>
+
+#include <cstdint>
+
+namespace kushner {
+
+/// Everything one step reads and writes. Views are (particle, member[, i]) or (member[, i]), LayoutLeft.
+template <class Model, class MemSpace>
+struct ParticleStepData {
+  static constexpr int n = Model::state_dim, p = Model::obs_dim, q = Model::noise_dim;
+  Model model;
+  ParticleBank<MemSpace> x;                                            // (particle, member, i)
+  Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> log_weight;     // (particle, member)
+  BankScalar<double, MemSpace> log_normalizer;                         // log sum_j exp(log_weight_j)
+  BankVector<MemSpace> reference;                                      // (member, i): previous posterior mean
+  BankVector<MemSpace> dy;                                             // (member, j): this step's increments
+  BankScalar<Status, MemSpace> status;
+  Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace> partials;      // (block, member, k)
+  Mat<p, p> observation_precision;  // (R R^T)^{-1} at t
+  Vec<n> initial_mean;
+  Mat<n, n> initial_root;           // any square root of the initial covariance
+  double t = 0.0, dt = 0.0;
+  double sqrt_dt = 0.0;             // computed once: nvcc re-evaluated sqrt(dt) for every particle
+  std::uint32_t seed = 0, step = 0;
+  int num_particles = 0, block_size = 0;
+  bool initialize = false;          // sample the initial law instead of propagating; no observation
+};
+
+/// The second step of a fused pair (particle_team_pair_step.hpp): step + 1, over [t, t + dt]. The pair reads the
+/// first step's x and log_weight and writes x and log_weight here (same layout), so that its first step can be
+/// recomputed from untouched inputs.
+template <class Model, class MemSpace>
+struct ParticleSecondStep {
+  static constexpr int p = Model::obs_dim;
+  ParticleBank<MemSpace> x;
+  Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> log_weight;
+  BankVector<MemSpace> dy;
+  Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace> partials;
+  Mat<p, p> observation_precision;
+  double t = 0.0;
+};
+
+/// Draws per particle and step: the normals of the initial state, or of the Euler-Maruyama step.
+template <class Model, bool Initialize>
+constexpr int particle_draw_dim = Initialize ? Model::state_dim : Model::noise_dim;
+
+template <class Model, bool Initialize>
+constexpr bool draws_uniform = !Initialize && has_exact_transition<Model>::value;
+
+/// The key and step of the particles' draws: their initial states, or step d.step.
+template <bool Initialize, class Model, class MemSpace>
+KOKKOS_INLINE_FUNCTION RngKey particle_draw_key(const ParticleStepData<Model, MemSpace>& d) {
+  return RngKey{d.seed, Initialize ? Stream::particle_initial : Stream::particle_noise};
+}
+template <bool Initialize, class Model, class MemSpace>
+KOKKOS_INLINE_FUNCTION std::uint32_t particle_draw_step(const ParticleStepData<Model, MemSpace>& d) {
+  return Initialize ? 0 : d.step;
+}
+
+/// The draws of particles 2 pair (z0, u0) and 2 pair + 1 (z1, u1) of `member` at `step`, from Random123's Philox
+/// (the team kernels; the host kernel draws a block at a time with SimdDraws, the same bits).
+template <class Model, bool Initialize>
+KOKKOS_INLINE_FUNCTION void draw_particle_pair(const RngKey& key, int member, int pair, std::uint32_t step,
+                                               Vec<particle_draw_dim<Model, Initialize>>& z0,
+                                               Vec<particle_draw_dim<Model, Initialize>>& z1, double& u0,
+                                               double& u1) {
+  constexpr int K = particle_draw_dim<Model, Initialize>;
+  KUSHNER_DEVICE_UNROLL
+  for (int i = 0; i < K; ++i) {
+    const NormalPair zi = pair_normals<Random123Draws>(key, member, pair, step, i);
+    z0[i] = zi.z0;
+    z1[i] = zi.z1;
+  }
+  u0 = u1 = 0.0;
+  if constexpr (draws_uniform<Model, Initialize>) pair_uniforms<Random123Draws>(key, member, pair, step, K, u0, u1);
+}
+
+/// V^{-1} dy of one member: the only observation term the likelihood needs besides h(x).
+template <class Model, class MemSpace>
+KOKKOS_INLINE_FUNCTION Vec<Model::obs_dim> precision_times_dy(const ParticleStepData<Model, MemSpace>& d, int member) {
+  return d.observation_precision * load<Model::obs_dim>(d.dy, member);
+}
+
+/// Moves one particle (x in, x out) over [t, t + dt] with its draws (normals z, uniform u) and returns its new
+/// log-weight, normalized by the member's previous log-normalizer; -inf for a particle that left the finite
+/// numbers. `precision` is V^{-1} at t.
+template <bool Initialize, class Model, class MemSpace>
+KOKKOS_INLINE_FUNCTION double update_particle(const ParticleStepData<Model, MemSpace>& d, double t,
+                                              const Mat<Model::obs_dim, Model::obs_dim>& precision,
+                                              const Vec<particle_draw_dim<Model, Initialize>>& z, double u,
+                                              double log_weight, double log_normalizer,
+                                              const Vec<Model::obs_dim>& vinv_dy, Vec<Model::state_dim>& x) {
+  constexpr int n = Model::state_dim, p = Model::obs_dim;
+  if constexpr (Initialize) {
+    x = d.initial_mean + d.initial_root * z;
+    return 0.0;
+  } else {
+    if constexpr (has_exact_transition<Model>::value) {
+      x = d.model.sample_exact_transition(t, x, d.dt, z, u);
+    } else {
+      const typename Model::Control control = Model::Control::zero();
+      x = x + d.model.drift(t, x, control) * d.dt + d.model.diffusion(t, x) * (z * d.sqrt_dt);
+    }
+    const Vec<p> h = d.model.observation(t + d.dt, x);
+    const double increment = dot(h, vinv_dy) - 0.5 * d.dt * dot(h, precision * h);
+    const double l = log_weight - log_normalizer + increment;
+    bool finite = math::is_finite(l);
+    KUSHNER_UNROLL_FULLY
+    for (int i = 0; i < n; ++i) finite = finite & math::is_finite(x[i]);  // `&`: no branch, so GCC can vectorize
+    return finite ? l : -positive_infinity();
+  }
+}
+
+/// The largest log-likelihood increment any particle can get from an increment dy: h.a - (dt/2) h^T V^-1 h
+/// with a = V^-1 dy is largest at h = V a / dt, where it is dy^T V^-1 dy / (2 dt). The previous log-weights
+/// are normalized (each <= 0), so this bounds every new log-weight from above; 0 where it is not finite.
+template <int P>
+KOKKOS_INLINE_FUNCTION double log_weight_bound(const Vec<P>& dy, const Vec<P>& vinv_dy, double dt) {
+  const double bound = 0.5 * dot(dy, vinv_dy) / dt;
+  return math::is_finite(bound) ? bound : 0.0;
+}
+
+}  // namespace kushner
