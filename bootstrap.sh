@@ -25,7 +25,7 @@ as_root() {
     die "need root (or sudo) to run: $*"; fi
 }
 
-debian_packages=(g++ cmake make patch dpkg-dev libeigen3-dev libcli11-dev librandom123-dev nlohmann-json3-dev
+debian_packages=(g++ cmake make patch dpkg-dev clang-format libeigen3-dev libcli11-dev librandom123-dev nlohmann-json3-dev
                  libtomlplusplus-dev googletest libgtest-dev libbenchmark-dev python3 python3-numpy python3-matplotlib)
 
 install_packages() {

@@ -17,8 +17,9 @@ std::vector<std::string> config_file_arguments(const std::string& path, const CL
   std::vector<std::string> args;
   for (const auto& item : items) {
     if (item.name == "++" || item.name == "--") continue;  // section open/close markers
-    KUSHNER_INPUT_REQUIRE(item.parents.empty() || (item.parents.size() == 1 && item.parents[0] == subcommand.get_name()),
-                          path << ": section '" << item.fullname() << "' is not [" << subcommand.get_name() << "]");
+    KUSHNER_INPUT_REQUIRE(
+        item.parents.empty() || (item.parents.size() == 1 && item.parents[0] == subcommand.get_name()),
+        path << ": section '" << item.fullname() << "' is not [" << subcommand.get_name() << "]");
     const CLI::Option* option = subcommand.get_option_no_throw("--" + item.name);
     KUSHNER_INPUT_REQUIRE(option != nullptr && item.name != "config",
                           path << ": unknown key '" << item.name << "' (keys are the long options of `kushner "

@@ -1,7 +1,7 @@
 #include "drivers/filter_command.hpp"
-#include "engine/backend.hpp"
 #include "drivers/commands.hpp"
 #include "drivers/run_model.hpp"
+#include "engine/backend.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -28,12 +28,14 @@ void print_summary(const nlohmann::json& summary, const std::string& out) {
                 number(f, "rmse_truth"), number(f, "rmse_truth_se"), number(f, "nees"), number(f, "nees_se"),
                 f["diverged"].get<long>());
   }
-  if (summary.contains("plots_error")) std::fprintf(stderr, "kushner: warning: %s\n",
-                                                    summary["plots_error"].get<std::string>().c_str());
+  if (summary.contains("plots_error"))
+    std::fprintf(stderr, "kushner: warning: %s\n", summary["plots_error"].get<std::string>().c_str());
   const bool report = std::any_of(summary["files"].begin(), summary["files"].end(),
                                   [](const nlohmann::json& f) { return f == "report.md"; });
   std::printf("written to %s/ (%s)\n", out.c_str(),
-              summary.value("plots", false) ? "report.md, plots, CSV, JSON" : report ? "report.md, CSV, JSON" : "CSV, JSON");
+              summary.value("plots", false) ? "report.md, plots, CSV, JSON"
+              : report                      ? "report.md, CSV, JSON"
+                                            : "CSV, JSON");
 }
 
 int run_estimation(const CompareOptions& options, const RunContext& context, const char* command) {

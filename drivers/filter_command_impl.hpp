@@ -3,18 +3,18 @@
 // filter_command_*.cpp files): select and check the filters, run the bank with the particle and exact
 // references beside it, write summary.json and timeseries.csv, and for compare the chosen members'
 // trajectories, the density snapshots, the plots and report.md.
-#include "engine/backend.hpp"
 #include "drivers/csv.hpp"
 #include "drivers/fields_json.hpp"
 #include "drivers/filter_command.hpp"
-#include "engine/filter_run.hpp"
 #include "drivers/filter_selection.hpp"
 #include "drivers/output_directory.hpp"
 #include "drivers/plots.hpp"
 #include "drivers/progress.hpp"
-#include "drivers/trajectory_recorder.hpp"
-#include "models/parameters.hpp"
 #include "drivers/run_model.hpp"
+#include "drivers/trajectory_recorder.hpp"
+#include "engine/backend.hpp"
+#include "engine/filter_run.hpp"
+#include "models/parameters.hpp"
 
 #include <algorithm>
 #include <functional>
@@ -126,10 +126,9 @@ nlohmann::json run_compare_with_truth(const TruthModel& truth_model, const Model
     Progress progress(options.plots ? "compare" : "filter", progress_steps<Model>(filters, grid), !options.run.quiet);
     OutputObserver<ExecSpace, Model, TruthModel> observer;
     if (!options.trajectory_members.empty()) observer = std::ref(recorder);
-    const FilterReport report =
-        run_filters(space, truth_model, model, options.run.members, static_cast<std::uint32_t>(options.run.seed), grid,
-                    filters, settings, particle, [&](long done) { progress.update(done); }, observer,
-                    make_extras(space));
+    const FilterReport report = run_filters(
+        space, truth_model, model, options.run.members, static_cast<std::uint32_t>(options.run.seed), grid, filters,
+        settings, particle, [&](long done) { progress.update(done); }, observer, make_extras(space));
     summary = run_metadata(context);
     summary["model"] = model_summary(model);
     if constexpr (!std::is_same_v<TruthModel, Model>)
@@ -175,8 +174,8 @@ nlohmann::json run_compare_command(const Model& model, const CompareOptions& opt
 }  // namespace kushner
 
 /// The explicit instantiations of the filter command for one model (the generated units of drivers/CMakeLists.txt).
-#define KUSHNER_INSTANTIATE_FILTER_COMMAND(Model)                                                                    \
-  template std::vector<std::string> check_compare_options<Model>(const Model&, const CompareOptions&,                \
-                                                                 const OptionValues&);                               \
-  template nlohmann::json run_compare_command<Model>(const Model&, const CompareOptions&, const OptionValues&,       \
+#define KUSHNER_INSTANTIATE_FILTER_COMMAND(Model)                                                              \
+  template std::vector<std::string> check_compare_options<Model>(const Model&, const CompareOptions&,          \
+                                                                 const OptionValues&);                         \
+  template nlohmann::json run_compare_command<Model>(const Model&, const CompareOptions&, const OptionValues&, \
                                                      const TimeGrid&, const RunContext&, const OutputDirectory&);

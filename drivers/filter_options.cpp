@@ -51,8 +51,7 @@ void add_filter_options(CLI::App& app, FilterOptions& o) {
     option->default_str(std::visit([](const auto& v) { return value_text(v); }, spec.default_value));
     if (spec.kind == OptionSpec::Kind::choice) option->check(CLI::IsMember(spec.choices));
   }
-  app.add_option("--particles", o.particles, "particles per member of the particle filter (PF)")
-      ->capture_default_str();
+  app.add_option("--particles", o.particles, "particles per member of the particle filter (PF)")->capture_default_str();
   app.add_option("--resample", o.resample, "PF resampling scheme: systematic, stratified, multinomial, residual")
       ->capture_default_str();
   app.add_option("--ess-threshold", o.ess_threshold,
@@ -80,7 +79,8 @@ ParticleSettings particle_settings(const FilterOptions& o) {
   settings.particles = o.particles;
   const std::optional<ResamplingScheme> scheme = resampling_scheme_named(o.resample);
   KUSHNER_INPUT_REQUIRE(scheme.has_value(), "--resample: unknown scheme '"
-                                                << o.resample << "' (known: multinomial, residual, stratified, systematic)");
+                                                << o.resample
+                                                << "' (known: multinomial, residual, stratified, systematic)");
   settings.options.scheme = *scheme;
   settings.options.ess_threshold = o.ess_threshold;
   return settings;
@@ -102,7 +102,8 @@ OptionValues filter_option_values(const FilterOptions& o) {
     }
     const std::string& text = given->second;
     const std::optional<Value> value = parse_value(text, spec.kind);
-    KUSHNER_INPUT_REQUIRE(value.has_value(), option_flag(spec.name) << ": expected "
+    KUSHNER_INPUT_REQUIRE(value.has_value(), option_flag(spec.name)
+                                                 << ": expected "
                                                  << (spec.kind == OptionSpec::Kind::integer ? "an integer" : "a number")
                                                  << " (got '" << text << "')");
     const std::string problem = option_value_problem(spec, *value);

@@ -35,8 +35,8 @@ std::vector<std::string> select_filters(const std::string& list, const Model& mo
     if (it == support.end()) {
       std::string known;
       for (const auto& f : support) known += (known.empty() ? "" : ", ") + f.name;
-      throw InputError("--filters: unknown filter '" + name + "' (known: " + known + ", " + particle_filter_name + ", " +
-                       exact_filter_name + ", or all)");
+      throw InputError("--filters: unknown filter '" + name + "' (known: " + known + ", " + particle_filter_name +
+                       ", " + exact_filter_name + ", or all)");
     }
     KUSHNER_INPUT_REQUIRE(it->unsupported == nullptr, "filter " << name << " does not support model '" << Model::name
                                                                 << "' (" << it->unsupported << ")");
@@ -70,9 +70,8 @@ std::vector<std::string> select_estimators(const std::string& list, const Model&
       particle = true;
     } else if (current == exact_filter_name) {
       const char* why_not = exact_filter_unsupported(model);
-      KUSHNER_INPUT_REQUIRE(why_not == nullptr,
-                            "filter " << exact_filter_name << " does not support model '" << Model::name << "' ("
-                                      << why_not << ")");
+      KUSHNER_INPUT_REQUIRE(why_not == nullptr, "filter " << exact_filter_name << " does not support model '"
+                                                          << Model::name << "' (" << why_not << ")");
       exact = true;
     } else {
       bank_list += (bank_list.empty() ? "" : ",") + current;

@@ -1,13 +1,13 @@
-#include "engine/backend.hpp"
 #include "drivers/commands.hpp"
 #include "drivers/filter_options.hpp"
 #include "drivers/filter_selection.hpp"
+#include "engine/backend.hpp"
 #include "models/registry.hpp"
 
 #include <cmath>
 #include <iostream>
-#include <variant>
 #include <map>
+#include <variant>
 
 namespace kushner {
 
@@ -60,8 +60,10 @@ int run_filters_list(bool json) {
           if (o.positive) option["positive"] = true;
           options[f.name].push_back(option);
         }
-        if (f.unsupported == nullptr) supported[f.name].push_back(Model::name);
-        else refused[f.name].push_back({{"model", Model::name}, {"reason", f.unsupported}});
+        if (f.unsupported == nullptr)
+          supported[f.name].push_back(Model::name);
+        else
+          refused[f.name].push_back({{"model", Model::name}, {"reason", f.unsupported}});
       }
     }
   });
@@ -87,8 +89,8 @@ int run_filters_list(bool json) {
     for (const auto& r : f["refuses"])
       std::cout << "    not " << r["model"].get<std::string>() << ": " << r["reason"].get<std::string>() << "\n";
     for (const auto& o : f["options"])
-      std::cout << "    " << o["name"].get<std::string>() << " (default " << o["default"].dump() << "): "
-                << o["help"].get<std::string>() << "\n";
+      std::cout << "    " << o["name"].get<std::string>() << " (default " << o["default"].dump()
+                << "): " << o["help"].get<std::string>() << "\n";
   }
   return 0;
 }

@@ -1,8 +1,8 @@
 // kushner: banks of nonlinear stochastic systems and filters. Command-line entry point.
-#include "engine/backend.hpp"
+#include "core/errors.hpp"
 #include "drivers/commands.hpp"
 #include "drivers/config_file.hpp"
-#include "core/errors.hpp"
+#include "engine/backend.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -42,8 +42,9 @@ std::unique_ptr<CLI::App> make_app(Options& o) {
   app->add_flag("--version", o.version, "print versions, the backend and its threads or device");
   add_run_options(*app->add_subcommand("simulate", "simulate the bank of truths and observations"), o.simulate);
   add_filter_options(*app->add_subcommand("filter", "run the bank of truths and filters side by side"), o.filter);
-  add_compare_options(*app->add_subcommand("compare", "filters against the particle reference, with plots and a "
-                                                      "report (the main job; defaults: the sine model)"),
+  add_compare_options(*app->add_subcommand("compare",
+                                           "filters against the particle reference, with plots and a "
+                                           "report (the main job; defaults: the sine model)"),
                       o.compare);
   add_reproduce_options(*app->add_subcommand("reproduce",
                                              "run a worked example of the seed papers and put the "

@@ -135,17 +135,10 @@ void with_model_file(const std::string& path, const std::vector<std::string>& se
     f(model);
   };
   switch (spec.n) {
-    case 1:
-      run(static_cast<PolynomialModel<1>*>(nullptr));
-      break;
-    case 2:
-      run(static_cast<PolynomialModel<2>*>(nullptr));
-      break;
-    case 3:
-      run(static_cast<PolynomialModel<3>*>(nullptr));
-      break;
-    default:
-      KUSHNER_REQUIRE(false, "read_polynomial_model_file let state_dim " << spec.n << " through");
+    case 1: run(static_cast<PolynomialModel<1>*>(nullptr)); break;
+    case 2: run(static_cast<PolynomialModel<2>*>(nullptr)); break;
+    case 3: run(static_cast<PolynomialModel<3>*>(nullptr)); break;
+    default: KUSHNER_REQUIRE(false, "read_polynomial_model_file let state_dim " << spec.n << " through");
   }
 }
 

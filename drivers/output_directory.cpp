@@ -23,8 +23,8 @@ OutputDirectory::OutputDirectory(const std::filesystem::path& path, const std::s
   const auto probe = path / ".kushner-write-test.tmp";
   {
     std::ofstream out(probe);
-    KUSHNER_INPUT_REQUIRE(out.good(), option << ": directory '" << path.string() << "' is not writable: "
-                                             << std::strerror(errno));
+    KUSHNER_INPUT_REQUIRE(out.good(),
+                          option << ": directory '" << path.string() << "' is not writable: " << std::strerror(errno));
   }
   std::filesystem::remove(probe, ec);
 }

@@ -57,7 +57,8 @@ PlotResult write_plots_and_report(const OutputDirectory& out) {
   result.ok = true;
   for (const char* name : {"estimates", "errors", "rmse_ref", "density"})
     for (const char* ext : {".png", ".svg"})
-      if (std::filesystem::exists(out.path() / (std::string(name) + ext))) result.files.push_back(name + std::string(ext));
+      if (std::filesystem::exists(out.path() / (std::string(name) + ext)))
+        result.files.push_back(name + std::string(ext));
   result.files.push_back("report.md");
   return result;
 }

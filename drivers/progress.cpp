@@ -1,7 +1,7 @@
 #include "drivers/progress.hpp"
 
-#include <cstdio>
 #include <unistd.h>
+#include <cstdio>
 
 namespace kushner {
 

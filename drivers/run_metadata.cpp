@@ -32,8 +32,10 @@ std::string command_line(int argc, char** argv) {
       const auto slash = arg.find_last_of('/');
       if (slash != std::string::npos) arg = arg.substr(slash + 1);
     }
-    const bool plain = !arg.empty() && arg.find_first_not_of(
-        "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_=./,:+@%") == std::string::npos;
+    const bool plain =
+        !arg.empty() &&
+        arg.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_=./,:+@%") ==
+            std::string::npos;
     if (!plain) {
       std::string quoted = "'";
       for (char c : arg) quoted += (c == '\'') ? std::string("'\\''") : std::string(1, c);

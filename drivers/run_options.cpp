@@ -31,15 +31,18 @@ void validate_run_options(const RunOptions& o) {
   KUSHNER_INPUT_REQUIRE(!(o.model_given && !o.model_file.empty()),
                         "--model-file: give either --model or --model-file, not both (the file defines the model)");
   KUSHNER_INPUT_REQUIRE(o.members > 0, "--members: must be positive (got " << o.members << ")");
-  KUSHNER_INPUT_REQUIRE(o.members <= std::numeric_limits<std::int32_t>::max(),
-                        "--members: at most " << std::numeric_limits<std::int32_t>::max() << " (got " << o.members << ")");
+  KUSHNER_INPUT_REQUIRE(
+      o.members <= std::numeric_limits<std::int32_t>::max(),
+      "--members: at most " << std::numeric_limits<std::int32_t>::max() << " (got " << o.members << ")");
   KUSHNER_INPUT_REQUIRE(std::isfinite(o.dt) && o.dt > 0.0, "--dt: must be positive (got " << o.dt << ")");
   KUSHNER_INPUT_REQUIRE(std::isfinite(o.T) && o.T > 0.0, "--T: must be positive (got " << o.T << ")");
-  KUSHNER_INPUT_REQUIRE(o.seed >= 0 && o.seed <= 0xffffffffLL, "--seed: must be in 0 .. 4294967295 (got " << o.seed << ")");
+  KUSHNER_INPUT_REQUIRE(o.seed >= 0 && o.seed <= 0xffffffffLL,
+                        "--seed: must be in 0 .. 4294967295 (got " << o.seed << ")");
   KUSHNER_INPUT_REQUIRE(o.output_points > 0, "--output-points: must be positive (got " << o.output_points << ")");
   const double ratio = o.T / o.dt;
   const TimeGridProblem problem = time_grid_problem(o.T, o.dt);
-  KUSHNER_INPUT_REQUIRE(problem != TimeGridProblem::dt_above_T, "--dt: larger than --T (" << o.dt << " > " << o.T << ")");
+  KUSHNER_INPUT_REQUIRE(problem != TimeGridProblem::dt_above_T,
+                        "--dt: larger than --T (" << o.dt << " > " << o.T << ")");
   KUSHNER_INPUT_REQUIRE(problem != TimeGridProblem::too_many_steps,
                         "--dt: too small for --T (" << ratio << " steps; at most 4e9)");
   KUSHNER_INPUT_REQUIRE(problem != TimeGridProblem::not_whole_steps,

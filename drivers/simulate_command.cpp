@@ -1,10 +1,10 @@
-#include "engine/backend.hpp"
 #include "drivers/commands.hpp"
 #include "drivers/csv.hpp"
 #include "drivers/output_directory.hpp"
 #include "drivers/progress.hpp"
-#include "engine/truth_bank.hpp"
 #include "drivers/run_model.hpp"
+#include "engine/backend.hpp"
+#include "engine/truth_bank.hpp"
 
 namespace kushner {
 
@@ -13,8 +13,7 @@ namespace {
 template <class Model>
 std::string timeseries_csv(const MomentSeries& series, const RunContext& context) {
   std::string csv = csv_comment(context) + "t";
-  for (int i = 1; i <= Model::state_dim; ++i)
-    csv += ",mean_x" + std::to_string(i) + ",var_x" + std::to_string(i);
+  for (int i = 1; i <= Model::state_dim; ++i) csv += ",mean_x" + std::to_string(i) + ",var_x" + std::to_string(i);
   csv += ",diverged\n";
   for (std::size_t r = 0; r < series.times.size(); ++r) {
     csv += format_number(series.times[r]);
@@ -36,8 +35,9 @@ int run_simulate(const RunOptions& options, const RunContext& context) {
     KokkosSession kokkos;
     with_backend(context.backend, [&](const auto& space) {
       Progress progress("simulate", grid.steps, !options.quiet);
-      const MomentSeries series = simulate_ensemble(space, model, options.members,
-                                                    static_cast<std::uint32_t>(options.seed), grid, [&](long done) { progress.update(done); });
+      const MomentSeries series =
+          simulate_ensemble(space, model, options.members, static_cast<std::uint32_t>(options.seed), grid,
+                            [&](long done) { progress.update(done); });
       nlohmann::json summary = run_metadata(context);
       summary["model"] = model_summary(model);
       summary["members"] = options.members;

@@ -3,11 +3,11 @@
 // filter's estimate with its +-2 sigma band, the particle mean with its 5-95% band (trajectories.csv); and for
 // 1-D models the particle density of the first chosen member against each filter's Gaussian at chosen times
 // (density.csv). Only those members are copied to the host, so it costs little next to the run.
+#include "core/errors.hpp"
 #include "drivers/csv.hpp"
+#include "drivers/run_metadata.hpp"
 #include "engine/filter_bank.hpp"
 #include "engine/reference_estimator.hpp"
-#include "drivers/run_metadata.hpp"
-#include "core/errors.hpp"
 #include "kernels/host_copy.hpp"
 
 #include <Kokkos_Core.hpp>
@@ -32,8 +32,8 @@ class TrajectoryRecorder {
   TrajectoryRecorder(const std::vector<long>& members, long num_members, std::vector<double> density_times)
       : members_(members), density_times_(std::move(density_times)) {
     for (long m : members_)
-      KUSHNER_INPUT_REQUIRE(m >= 0 && m < num_members, "--trajectory-members: member " << m << " is not in 0 .. "
-                                                                                        << num_members - 1);
+      KUSHNER_INPUT_REQUIRE(m >= 0 && m < num_members,
+                            "--trajectory-members: member " << m << " is not in 0 .. " << num_members - 1);
     std::sort(density_times_.begin(), density_times_.end());
     trajectories_ = "member,t,component,series,estimate,lower,upper\n";
     density_ = "t,member,x,series,density\n";
@@ -57,8 +57,8 @@ class TrajectoryRecorder {
       const auto x = row(bank.truths().state(), member);
       for (int i = 0; i < n; ++i) add_trajectory(member, t, i, "truth", x(i), x(i), x(i));
       for (const auto& name : bank.filter_names())
-        bank.with_slot(name, [&](const auto& slot) { add_gaussian(member, t, name, row(slot.m, member),
-                                                                  row(slot.P, member)); });
+        bank.with_slot(
+            name, [&](const auto& slot) { add_gaussian(member, t, name, row(slot.m, member), row(slot.P, member)); });
       for (const auto* e : outside) {
         if (e == pf) {
           const auto mean = row(pf->mean(), member);

@@ -3,8 +3,8 @@
 // filter the model supports as a slot (kernels/filters/filter_slot.hpp) with the selected ones allocated and
 // enabled, the fused step kernel, and the reductions behind the reported metrics. Estimators outside the bank
 // (particle filter, exact filters: engine/reference_estimator.hpp) step on the same dy right after it and are
-// scored like filters; one of them may be the reference that every other estimate is measured against. Reductions go through
-// ensemble_moments (fixed-order blocks), so every number is the same on any number of threads.
+// scored like filters; one of them may be the reference that every other estimate is measured against. Reductions go
+// through ensemble_moments (fixed-order blocks), so every number is the same on any number of threads.
 #include "engine/reference_estimator.hpp"
 #include "engine/truth_bank.hpp"
 #include "kernels/ensemble_moments.hpp"
@@ -39,7 +39,7 @@ struct FilterSnapshot {
   double nees_se = 0.0;
   double rmse_ref = 0.0;  // against the reference mean, when there is one
   double rmse_ref_se = 0.0;
-  long diverged = 0;      // members whose filter has diverged by now (their truth not escaped)
+  long diverged = 0;  // members whose filter has diverged by now (their truth not escaped)
 };
 
 /// One filter over the whole run: time-and-ensemble means over the members scored at the end.
@@ -98,7 +98,8 @@ class FilterBank {
         found = true;
         slot.enabled = true;
         const std::optional<Filter>& ready = std::get<std::optional<Filter>>(prepared);
-        slot.filter = ready ? *ready : Filter::create(options.with_defaults(filter_options<Filter>()), filter_model, members);
+        slot.filter =
+            ready ? *ready : Filter::create(options.with_defaults(filter_options<Filter>()), filter_model, members);
         slot.m = BankVector<MemSpace>(std::string("kushner::m_") + Filter::name, members, n);
         slot.P = BankSymmetric<MemSpace>(std::string("kushner::P_") + Filter::name, members, packed_size(n));
         slot.status = BankScalar<Status, MemSpace>(std::string("kushner::status_") + Filter::name, members);
@@ -220,9 +221,8 @@ class FilterBank {
       s.rmse_truth_se = rmse.standard_error;
       s.nees = nees.value;
       s.nees_se = nees.standard_error;
-      const Estimate ref = scored_against_reference(name)
-                               ? root_mean(slot.snapshot, snapshot_reference_squared_error)
-                               : Estimate{std::nan(""), std::nan(""), 0};
+      const Estimate ref = scored_against_reference(name) ? root_mean(slot.snapshot, snapshot_reference_squared_error)
+                                                          : Estimate{std::nan(""), std::nan(""), 0};
       s.rmse_ref = ref.value;
       s.rmse_ref_se = ref.standard_error;
       s.diverged = count_status(space_, slot.status, Status::not_positive_definite, truth_status_) +

@@ -35,9 +35,9 @@ struct FilterReport {
   std::vector<FilterScores> scores;                 // [filter], over the whole run
   long truths_escaped = 0;                          // members left out of every metric
   bool has_reference = false;
-  std::string reference;                            // the reference's name (PF, EXACT) when has_reference
-  std::map<std::string, Fields> filter_fields;      // bank filter -> what it adds to its summary
-  std::map<std::string, Fields> estimators;         // estimator beside the bank -> its describe()
+  std::string reference;                        // the reference's name (PF, EXACT) when has_reference
+  std::map<std::string, Fields> filter_fields;  // bank filter -> what it adds to its summary
+  std::map<std::string, Fields> estimators;     // estimator beside the bank -> its describe()
 };
 
 /// Called at t = 0 and at every output time with the bank and the outside estimators (PF, EXACT), e.g. to
@@ -71,8 +71,8 @@ namespace detail {
 /// passes.
 template <class ExecSpace, class Model, class TruthModel>
 typename FilterBank<ExecSpace, Model, TruthModel>::PreparedFilters prepare_filters(
-    const ExecSpace& space, const TruthModel& truth_model, const Model& filter_model, long members,
-    std::uint32_t seed, const TimeGrid& grid, const std::vector<std::string>& filters, const OptionValues& options,
+    const ExecSpace& space, const TruthModel& truth_model, const Model& filter_model, long members, std::uint32_t seed,
+    const TimeGrid& grid, const std::vector<std::string>& filters, const OptionValues& options,
     const ProgressCallback& progress, long& progress_base) {
   using Bank = FilterBank<ExecSpace, Model, TruthModel>;
   using MemSpace = typename ExecSpace::memory_space;
@@ -93,8 +93,8 @@ typename FilterBank<ExecSpace, Model, TruthModel>::PreparedFilters prepare_filte
         progress_base += grid.steps;
         return bank.members_ok(Filter::name);
       };
-      std::get<std::optional<Filter>>(prepared) = Filter::prepare(
-          options.with_defaults(filter_options<Filter>()), filter_model, members, run_alone);
+      std::get<std::optional<Filter>>(prepared) =
+          Filter::prepare(options.with_defaults(filter_options<Filter>()), filter_model, members, run_alone);
       progress_base = start + filter_prepass_passes<Filter>() * grid.steps;
     }
   });
@@ -125,8 +125,8 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
       bank_filters.push_back(name);
     } else if (name == particle_filter_name) {
       if constexpr (particle_filter_unsupported<Model>() == nullptr)
-        outside.push_back(std::make_unique<ParticleReference<ExecSpace, Model>>(space, filter_model, members, seed,
-                                                                                particle));
+        outside.push_back(
+            std::make_unique<ParticleReference<ExecSpace, Model>>(space, filter_model, members, seed, particle));
     } else if constexpr (has_exact_reference<Model>) {
       outside.push_back(std::make_unique<ExactReferenceEstimator<ExecSpace, Model>>(space, filter_model, members));
     }

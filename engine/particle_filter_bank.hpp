@@ -18,21 +18,21 @@
 //
 // step_pair takes two steps with one pass over the particles where the team kernel and the chunked
 // resampling run (the GPU's default): see step_pair.
-#include "kernels/bank.hpp"
+#include "core/eigen_helpers.hpp"
 #include "core/errors.hpp"
-#include "kernels/for_each_member.hpp"
 #include "core/linear_algebra.hpp"
+#include "kernels/bank.hpp"
+#include "kernels/for_each_member.hpp"
 #include "kernels/particle_filter/chunked_systematic_resample.hpp"
 #include "kernels/particle_filter/copy_listed_members.hpp"
+#include "kernels/particle_filter/particle_block_step.hpp"
 #include "kernels/particle_filter/particle_posterior.hpp"
 #include "kernels/particle_filter/particle_resample_step.hpp"
-#include "kernels/particle_filter/particle_block_step.hpp"
 #include "kernels/particle_filter/particle_team_pair_step.hpp"
 #include "kernels/particle_filter/particle_team_step.hpp"
 #include "kernels/particle_filter/resampling.hpp"
 #include "kernels/particle_filter/resampling_scheme.hpp"
 #include "kernels/particle_filter/tuning.hpp"
-#include "core/eigen_helpers.hpp"
 
 #include <Kokkos_Core.hpp>
 
@@ -57,7 +57,7 @@ struct ParticleFilterOptions {
   double ess_threshold = 0.5;  // resample a member when ESS < ess_threshold * N
   ParticleInitialLaw initial_law = ParticleInitialLaw::prior;
   ParticleKernel kernel = ParticleKernel::automatic;
-  int team_size = 0;           // team kernel and resampling: 0 = the backend's default
+  int team_size = 0;             // team kernel and resampling: 0 = the backend's default
   int particles_per_thread = 0;  // team kernel: 0 = device_particles_per_thread
 };
 
@@ -68,17 +68,20 @@ class ParticleFilterBank {
   static constexpr int state_dim = Model::state_dim;
   static_assert(!Model::discrete_time, "ParticleFilterBank: continuous-time models only (dy increments)");
 
-  ParticleFilterBank(const ExecSpace& space, const Model& model, int num_members, int num_particles,
-                     std::uint32_t seed, ResamplingScheme scheme = ResamplingScheme::systematic,
-                     double ess_threshold = 0.5)
+  ParticleFilterBank(const ExecSpace& space, const Model& model, int num_members, int num_particles, std::uint32_t seed,
+                     ResamplingScheme scheme = ResamplingScheme::systematic, double ess_threshold = 0.5)
       : ParticleFilterBank(space, model, num_members, num_particles, seed,
                            ParticleFilterOptions{scheme, ess_threshold}) {}
 
   /// Samples the initial particles and computes the time-0 posterior. Requires sizes >= 1 and a threshold in
   /// [0, 1] (std::logic_error otherwise: user input is checked where it is read, drivers/filter_options.cpp).
-  ParticleFilterBank(const ExecSpace& space, const Model& model, int num_members, int num_particles,
-                     std::uint32_t seed, const ParticleFilterOptions& options)
-      : space_(space), model_(model), options_(options), seed_(seed), num_members_(num_members),
+  ParticleFilterBank(const ExecSpace& space, const Model& model, int num_members, int num_particles, std::uint32_t seed,
+                     const ParticleFilterOptions& options)
+      : space_(space),
+        model_(model),
+        options_(options),
+        seed_(seed),
+        num_members_(num_members),
         num_particles_(num_particles) {
     KUSHNER_REQUIRE(num_members >= 1, "members: " << num_members);
     KUSHNER_REQUIRE(num_particles >= 1, "particles: " << num_particles);
@@ -89,10 +92,10 @@ class ParticleFilterBank {
     constexpr bool host_memory = std::is_same<MemSpace, Kokkos::HostSpace>::value;
     KUSHNER_REQUIRE(use_team_ || host_memory, "the host block kernel needs host memory");
     team_size_ = options.team_size > 0 ? options.team_size : (host_memory ? 1 : device_particle_team);
-    const int per_thread = options.particles_per_thread > 0 ? options.particles_per_thread : device_particles_per_thread;
+    const int per_thread =
+        options.particles_per_thread > 0 ? options.particles_per_thread : device_particles_per_thread;
     // The team kernel on the host (tests) keeps 1024-particle chunks, so small tests still merge several.
-    block_size_ = use_team_ ? (host_memory ? 1024 : team_size_ * per_thread)
-                            : host_particle_block;
+    block_size_ = use_team_ ? (host_memory ? 1024 : team_size_ * per_thread) : host_particle_block;
     num_blocks_ = (num_particles + block_size_ - 1) / block_size_;
     KUSHNER_REQUIRE(block_size_ % 2 == 0,
                     "particle blocks must hold whole pairs of particles (block of " << block_size_ << ")");
@@ -102,8 +105,8 @@ class ParticleFilterBank {
     x_scratch_ = ParticleBank<MemSpace>("kushner::particles_scratch", num_particles, num_members, n);
     workspace_.cumulative = decltype(workspace_.cumulative)("kushner::log_weights", num_particles, num_members);
     workspace_.ancestors = decltype(workspace_.ancestors)("kushner::ancestors", num_particles, num_members);
-    use_chunked_resample_ = use_team_ && options.scheme == ResamplingScheme::systematic &&
-                            chunked_resample_supports(num_particles);
+    use_chunked_resample_ =
+        use_team_ && options.scheme == ResamplingScheme::systematic && chunked_resample_supports(num_particles);
     if (use_chunked_resample_) {
       resample_list_ = Kokkos::View<int*, MemSpace>("kushner::resample_list", num_members);
       resample_list_size_ = Kokkos::View<int, MemSpace>("kushner::resample_list_size");
@@ -168,8 +171,8 @@ class ParticleFilterBank {
                                                 WeightedMoments<state_dim>::size);
     }
     const auto first = static_cast<std::uint32_t>(k), second = first + 1;
-    const ParticleSecondStep<Model, MemSpace> next{x_next_, log_weight_next_, dy_next, partials_next_,
-                                                   observation_precision((k + 1) * dt), (k + 1) * dt};
+    const ParticleSecondStep<Model, MemSpace> next{
+        x_next_, log_weight_next_, dy_next, partials_next_, observation_precision((k + 1) * dt), (k + 1) * dt};
     run_team_kernel(ParticleTeamPairStep<Model, ExecSpace>{step_data(k * dt, dt, first, dy), next});
     // The pass's output becomes the bank; its input (step k - 1's particles) stays for the redo.
     std::swap(x_, x_next_);
@@ -180,9 +183,10 @@ class ParticleFilterBank {
     run_posterior(partials_, first_, first_log_normalizer_, false);
     // The members step k resamples: copy their step k - 1 particles back, step k, resample, step k + 1.
     const long copy_items = static_cast<long>(num_members_) * num_particles_;
-    copy_listed_members<state_dim>(space_, CopyListedMembers<state_dim, MemSpace>{
-        x_next_, x_, log_weight_next_, workspace_.cumulative, resample_list_, resample_list_size_, num_particles_,
-        copy_items < listed_copy_items ? copy_items : listed_copy_items});
+    copy_listed_members<state_dim>(
+        space_, CopyListedMembers<state_dim, MemSpace>{
+                    x_next_, x_, log_weight_next_, workspace_.cumulative, resample_list_, resample_list_size_,
+                    num_particles_, copy_items < listed_copy_items ? copy_items : listed_copy_items});
     run_team_kernel_listed(ParticleTeamStep<Model, ExecSpace>{step_data(k * dt, dt, first, dy)});
     resample_listed(first_log_normalizer_, first);
     ParticleStepData<Model, MemSpace> redo = step_data((k + 1) * dt, dt, second, dy_next);
@@ -238,8 +242,8 @@ class ParticleFilterBank {
  private:
   void require_increments_shape(const BankVector<MemSpace>& dy) const {
     KUSHNER_REQUIRE(dy.extent_int(0) == num_members_ && dy.extent_int(1) == Model::obs_dim,
-                    "dy has shape (" << dy.extent(0) << ", " << dy.extent(1) << "), expected (" << num_members_
-                                     << ", " << Model::obs_dim << ")");
+                    "dy has shape (" << dy.extent(0) << ", " << dy.extent(1) << "), expected (" << num_members_ << ", "
+                                     << Model::obs_dim << ")");
   }
 
   /// (R R^T)^{-1} at t.
@@ -247,7 +251,8 @@ class ParticleFilterBank {
     constexpr int p = Model::obs_dim;
     const Mat<p, p> r = model_.observation_noise(t);
     Mat<p, p> root;
-    KUSHNER_REQUIRE(cholesky(r * transpose(r), root), Model::name << ": observation noise R R^T not positive definite at t=" << t);
+    KUSHNER_REQUIRE(cholesky(r * transpose(r), root),
+                    Model::name << ": observation noise R R^T not positive definite at t=" << t);
     return cholesky_inverse(root);
   }
 
@@ -311,27 +316,33 @@ class ParticleFilterBank {
   /// and counts, and the list of members to resample, into the bank's.
   void run_posterior(const Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace>& partials, const PosteriorViews& out,
                      const BankScalar<double, MemSpace>& log_normalizer, bool update_reference) {
-    parallel_for_members(
-        "kushner::particle_posterior", space_, num_members_,
-        ParticlePosterior<state_dim, MemSpace>{partials, num_blocks_, reference_, update_reference, out.mean,
-                                               out.covariance, out.ess, log_normalizer, resample_, resample_count_,
-                                               status_, options_.ess_threshold * num_particles_, resample_list_,
-                                               resample_list_size_});
+    parallel_for_members("kushner::particle_posterior", space_, num_members_,
+                         ParticlePosterior<state_dim, MemSpace>{
+                             partials, num_blocks_, reference_, update_reference, out.mean, out.covariance, out.ess,
+                             log_normalizer, resample_, resample_count_, status_,
+                             options_.ess_threshold * num_particles_, resample_list_, resample_list_size_});
   }
 
   PosteriorViews current_posterior() const { return {mean_, covariance_, ess_}; }
 
   /// Chunked systematic resampling of the listed members at `step`, from the log-weights less `log_normalizer`.
   void resample_listed(const BankScalar<double, MemSpace>& log_normalizer, std::uint32_t step) {
-    const ChunkedResampleData<MemSpace> r{x_, x_scratch_, workspace_.cumulative, workspace_.ancestors, block_sums_,
-                                          log_normalizer, resample_list_, resample_list_size_, num_particles_,
-                                          seed_, step};
+    const ChunkedResampleData<MemSpace> r{x_,
+                                          x_scratch_,
+                                          workspace_.cumulative,
+                                          workspace_.ancestors,
+                                          block_sums_,
+                                          log_normalizer,
+                                          resample_list_,
+                                          resample_list_size_,
+                                          num_particles_,
+                                          seed_,
+                                          step};
     // A fixed league loops over (member, chunk) items: the number of members to resample stays on the device.
     const long items = static_cast<long>(num_members_) * resample_chunks(num_particles_);
     const int league = static_cast<int>(items < chunked_resample_league ? items : chunked_resample_league);
     constexpr bool host_memory = std::is_same<MemSpace, Kokkos::HostSpace>::value;
-    chunked_systematic_resample<state_dim>(space_, r, host_memory ? team_size_ : device_chunked_resample_team,
-                                           league);
+    chunked_systematic_resample<state_dim>(space_, r, host_memory ? team_size_ : device_chunked_resample_team, league);
   }
 
   void allocate_first_step() {
@@ -345,7 +356,8 @@ class ParticleFilterBank {
   /// A team kernel (ParticleTeamStep, ParticleTeamPairStep) over every (chunk, member), a team each.
   template <class Kernel>
   void run_team_kernel(const Kernel& kernel) {
-    launch_team_kernel<Kernel>(static_cast<long>(num_blocks_) * num_members_, EveryMemberChunk<Kernel>{kernel, num_blocks_});
+    launch_team_kernel<Kernel>(static_cast<long>(num_blocks_) * num_members_,
+                               EveryMemberChunk<Kernel>{kernel, num_blocks_});
   }
 
   /// ... over the chunks of the members on the resampling list only: a fixed league loops over them.

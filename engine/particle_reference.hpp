@@ -5,9 +5,9 @@
 // the squared Monte Carlo error of the particle mean (Kong, Liu & Wong 1994): rmse_ref cannot tell apart
 // filters closer to the particle mean than its root mean, the reference's noise floor. Reduced on the host
 // in member order, so the figures are the same on any number of threads.
+#include "engine/particle_filter_bank.hpp"
 #include "engine/reference_estimator.hpp"
 #include "kernels/for_each_member.hpp"
-#include "engine/particle_filter_bank.hpp"
 
 #include <Kokkos_Core.hpp>
 

@@ -4,8 +4,8 @@
 // a few chosen ones); every statistic below is then computed there, in particle order, so it is
 // deterministic. Host code only.
 #include "core/errors.hpp"
-#include "kernels/host_copy.hpp"
 #include "engine/particle_filter_bank.hpp"
+#include "kernels/host_copy.hpp"
 
 #include <Kokkos_Core.hpp>
 
@@ -21,7 +21,9 @@ class ParticleSnapshot {
  public:
   template <class ExecSpace, class Model>
   explicit ParticleSnapshot(const ParticleFilterBank<ExecSpace, Model>& pf)
-      : members_(pf.num_members()), particles_(pf.num_particles()), dim_(Model::state_dim),
+      : members_(pf.num_members()),
+        particles_(pf.num_particles()),
+        dim_(Model::state_dim),
         x_(Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pf.particles())),
         w_("kushner::snapshot_weights", particles_, members_) {
     const auto lw = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pf.log_weights());
@@ -36,16 +38,19 @@ class ParticleSnapshot {
   /// copying the whole bank.
   template <class ExecSpace, class Model>
   ParticleSnapshot(const ParticleFilterBank<ExecSpace, Model>& pf, const std::vector<int>& members)
-      : members_(pf.num_members()), particles_(pf.num_particles()), dim_(Model::state_dim),
+      : members_(pf.num_members()),
+        particles_(pf.num_particles()),
+        dim_(Model::state_dim),
         x_("kushner::snapshot_particles", particles_, members.size(), dim_),
-        w_("kushner::snapshot_weights", particles_, members.size()), column_(members_, -1) {
+        w_("kushner::snapshot_weights", particles_, members.size()),
+        column_(members_, -1) {
     const auto ln = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pf.log_normalizer());
     for (std::size_t k = 0; k < members.size(); ++k) {
       const int m = members[k];
       KUSHNER_REQUIRE(m >= 0 && m < members_, "snapshot: member " << m << " out of range");
       column_[m] = static_cast<int>(k);
-      const auto lw = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(),
-                                                          Kokkos::subview(pf.log_weights(), Kokkos::ALL, m));
+      const auto lw =
+          Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), Kokkos::subview(pf.log_weights(), Kokkos::ALL, m));
       const auto x = host_copy(Kokkos::subview(pf.particles(), Kokkos::ALL, m, Kokkos::ALL));
       for (int j = 0; j < particles_; ++j) {
         w_(j, k) = std::exp(lw(j) - ln(m));
@@ -86,8 +91,8 @@ class ParticleSnapshot {
   /// [lo, hi), divided by the bin width (a density); mass outside [lo, hi) is left out.
   std::vector<double> histogram(int member, int i, double lo, double hi, int bins) const {
     const int c = column(member, i);  // the snapshot's column of the member
-    KUSHNER_INPUT_REQUIRE(hi > lo && bins >= 1, "histogram: need lo < hi and bins >= 1 (got " << lo << ", " << hi
-                                                                                          << ", " << bins << ")");
+    KUSHNER_INPUT_REQUIRE(hi > lo && bins >= 1,
+                          "histogram: need lo < hi and bins >= 1 (got " << lo << ", " << hi << ", " << bins << ")");
     std::vector<double> density(bins, 0.0);
     double total = 0.0;
     for (int j = 0; j < particles_; ++j) total += w_(j, c);

@@ -97,7 +97,8 @@ class PrintedCarFilter final : public ReferenceEstimator<typename ExecSpace::mem
   BankScalar<Status, MemSpace> status() const override { return status_; }
   Fields describe() const override {
     return {{"kind", std::string("printed equations")},
-            {"note", std::string("seed 002 (21) as printed: mean term (v/3l)(3 p_dd + m_d^3), dp_fd without (v/l) p_dd^2")}};
+            {"note",
+             std::string("seed 002 (21) as printed: mean term (v/3l)(3 p_dd + m_d^3), dp_fd without (v/l) p_dd^2")}};
   }
 
  private:

@@ -13,9 +13,9 @@ struct TimeGrid {
 /// What is wrong with T and dt as a grid (both positive and finite), if anything.
 enum class TimeGridProblem {
   none,
-  dt_above_T,        // fewer than half a step
-  too_many_steps,    // 4e9 steps or more (step counters are 32-bit)
-  not_whole_steps,   // T / dt is not a whole number (to 1e-9 relative)
+  dt_above_T,       // fewer than half a step
+  too_many_steps,   // 4e9 steps or more (step counters are 32-bit)
+  not_whole_steps,  // T / dt is not a whole number (to 1e-9 relative)
 };
 TimeGridProblem time_grid_problem(double T, double dt);
 

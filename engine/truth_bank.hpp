@@ -1,11 +1,11 @@
 #pragma once
 // Simulates the bank of truths over a time grid and records ensemble moments at the grid's output steps.
 // Shared by `kushner simulate`, the tests and the benchmarks.
+#include "core/eigen_helpers.hpp"
 #include "engine/progress_callback.hpp"
 #include "engine/time_grid.hpp"
 #include "kernels/ensemble_moments.hpp"
 #include "kernels/simulate_truth.hpp"
-#include "core/eigen_helpers.hpp"
 
 #include <cstdint>
 #include <vector>
@@ -28,9 +28,8 @@ class TruthBank {
         seed_(seed),
         x_("kushner::truth", members, Model::state_dim),
         observations_("kushner::observations", members, Model::obs_dim) {
-    initialize_gaussian<ExecSpace, Model::state_dim, MemSpace>(space_, x_, model.x0_mean,
-                                                               covariance_square_root(model.x0_cov),
-                                                               RngKey{seed, Stream::truth_initial});
+    initialize_gaussian<ExecSpace, Model::state_dim, MemSpace>(
+        space_, x_, model.x0_mean, covariance_square_root(model.x0_cov), RngKey{seed, Stream::truth_initial});
   }
 
   /// Step k: [k dt, (k+1) dt].

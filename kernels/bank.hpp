@@ -33,9 +33,7 @@ using BankScalar = Kokkos::View<T*, Kokkos::LayoutLeft, MemSpace>;
 KOKKOS_INLINE_FUNCTION constexpr int packed_size(int n) { return n * (n + 1) / 2; }
 
 /// Index of (i, j), i <= j, in the packed upper triangle.
-KOKKOS_INLINE_FUNCTION constexpr int packed_index(int n, int i, int j) {
-  return i * n - i * (i - 1) / 2 + (j - i);
-}
+KOKKOS_INLINE_FUNCTION constexpr int packed_index(int n, int i, int j) { return i * n - i * (i - 1) / 2 + (j - i); }
 
 template <int N, class View>
 KOKKOS_INLINE_FUNCTION Vec<N> load(const View& x, int member) {

@@ -4,8 +4,8 @@
 // thread, and the host merges the blocks in order (Chan et al.). A Kokkos parallel_reduce would combine
 // partial sums in an order that depends on the thread count. Members with a non-finite entry (a path that
 // escaped to infinity) are left out and counted.
-#include "kernels/bank.hpp"
 #include "core/math.hpp"
+#include "kernels/bank.hpp"
 
 #include <Kokkos_Core.hpp>
 

@@ -2,8 +2,8 @@
 // The bank of truths: initial states, and one step of every member in one kernel. Continuous-time models
 // take an Euler-Maruyama step and produce the observation increment dy over the step; discrete-time models
 // take x[k+1] = F(k, x[k], u) + w[k] and produce z[k+1] = H x[k+1] + v[k+1] in the same bank.
-#include "kernels/bank.hpp"
 #include "core/errors.hpp"
+#include "kernels/bank.hpp"
 #include "kernels/for_each_member.hpp"
 #include "kernels/rng.hpp"
 

@@ -3,10 +3,10 @@
 // variants (libmvec: _ZGV{b,c,d,e}N{2,4,8}v_sin, ...). glibc declares them only under -ffast-math
 // (bits/math-vector.h), whose other effects (finite-math-only, reassociation) we do not want; GCC also
 // needs -fno-math-errno to call them (CMake sets both when KUSHNER_ENABLE_VECTOR_MATH is on).
-// It is most of the host particle step's speed (perf/particle_filter.md, CPU section). libmvec's results are within 4 ulp of libm's, so the CPU
-// numbers differ from a scalar build in the last bits; within one binary they are the same on any number
-// of threads, because every backend calls the same block function (particle_filter/particle_block_step.hpp) or member
-// chunk function (for_each_member.hpp, which includes this header so that every unit compiles it alike).
+// It is most of the host particle step's speed (perf/particle_filter.md, CPU section). libmvec's results are within 4
+// ulp of libm's, so the CPU numbers differ from a scalar build in the last bits; within one binary they are the same on
+// any number of threads, because every backend calls the same block function (particle_filter/particle_block_step.hpp)
+// or member chunk function (for_each_member.hpp, which includes this header so that every unit compiles it alike).
 #if defined(KUSHNER_VECTOR_MATH) && defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && \
     !defined(__CUDACC__)
 #include <cmath>

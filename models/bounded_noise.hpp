@@ -6,8 +6,8 @@
 namespace kushner {
 
 struct BoundedPowerNoise {
-  double rho = 0.0;   // shape exponent
-  double bound = 1.0; // c
+  double rho = 0.0;    // shape exponent
+  double bound = 1.0;  // c
 
   /// Exact sample by the inverse CDF, F(y) = 1/2 + sign(y) |y/c|^{rho+1} / 2, from u uniform in (0, 1).
   KOKKOS_INLINE_FUNCTION double sample(double u) const {

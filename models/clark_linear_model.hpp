@@ -40,7 +40,8 @@ struct ClarkLinearModel : InitialLaw<1> {
   }
 
   void validate() const {
-    KUSHNER_INPUT_REQUIRE(w.rho > -1.0 && v.rho > -1.0, "rho_w, rho_v: must exceed -1 (got " << w.rho << ", " << v.rho << ")");
+    KUSHNER_INPUT_REQUIRE(w.rho > -1.0 && v.rho > -1.0,
+                          "rho_w, rho_v: must exceed -1 (got " << w.rho << ", " << v.rho << ")");
     KUSHNER_INPUT_REQUIRE(w.bound > 0.0 && v.bound > 0.0,
                           "bound_w, bound_v: must be positive (got " << w.bound << ", " << v.bound << ")");
   }
@@ -48,7 +49,9 @@ struct ClarkLinearModel : InitialLaw<1> {
   KOKKOS_INLINE_FUNCTION Vec<1> transition(int, const Vec<1>& x, const Control& u) const { return {{a * x[0] + u[0]}}; }
   KOKKOS_INLINE_FUNCTION Vec<1> process_noise(const Vec<1>& uniform) const { return {{w.sample(uniform[0])}}; }
   KOKKOS_INLINE_FUNCTION Vec<1> observation(int, const Vec<1>& x) const { return x; }
-  KOKKOS_INLINE_FUNCTION Vec<1> observation_noise_sample(const Vec<1>& uniform) const { return {{v.sample(uniform[0])}}; }
+  KOKKOS_INLINE_FUNCTION Vec<1> observation_noise_sample(const Vec<1>& uniform) const {
+    return {{v.sample(uniform[0])}};
+  }
 };
 
 }  // namespace kushner

@@ -12,12 +12,16 @@ struct OuModel : InitialLaw<1> {
   static constexpr int state_dim = 1, obs_dim = 1, noise_dim = 1, control_dim = 0;
   static constexpr bool discrete_time = false;
   static constexpr const char* name = "ou";
-  static constexpr const char* description = "scalar Ornstein-Uhlenbeck: dx = -theta (x - mu) dt + sigma dw, dy = x dt + r dv";
+  static constexpr const char* description =
+      "scalar Ornstein-Uhlenbeck: dx = -theta (x - mu) dt + sigma dw, dy = x dt + r dv";
   using Control = Vec<control_dim>;
 
   double theta = 1.0, mu = 0.0, sigma = 1.0, r = 0.5;
 
-  OuModel() { set_initial_law(Vec<1>{{1.0}}, Mat<1, 1>{{{0.0}}}); prior_cov = Mat<1, 1>{{{0.25}}}; }
+  OuModel() {
+    set_initial_law(Vec<1>{{1.0}}, Mat<1, 1>{{{0.0}}});
+    prior_cov = Mat<1, 1>{{{0.25}}};
+  }
 
   template <class Visitor>
   void parameters(Visitor&& v) {
@@ -28,7 +32,9 @@ struct OuModel : InitialLaw<1> {
     initial_law_parameters(v);
   }
 
-  KOKKOS_INLINE_FUNCTION Vec<1> drift(double, const Vec<1>& x, const Control&) const { return {{-theta * (x[0] - mu)}}; }
+  KOKKOS_INLINE_FUNCTION Vec<1> drift(double, const Vec<1>& x, const Control&) const {
+    return {{-theta * (x[0] - mu)}};
+  }
   KOKKOS_INLINE_FUNCTION Mat<1, 1> drift_jacobian(double, const Vec<1>&, const Control&) const { return {{{-theta}}}; }
   KOKKOS_INLINE_FUNCTION Mat<1, 1> drift_hessian(double, const Vec<1>&, const Control&, int) const { return {{{0.0}}}; }
   KOKKOS_INLINE_FUNCTION Mat<1, 1> diffusion(double, const Vec<1>&) const { return {{{sigma}}}; }

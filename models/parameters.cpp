@@ -83,8 +83,7 @@ ParameterValue parse_parameter_value(const std::string& key, const std::string& 
 
 std::pair<std::string, std::string> split_assignment(const std::string& assignment) {
   const auto eq = assignment.find('=');
-  KUSHNER_INPUT_REQUIRE(eq != std::string::npos && eq > 0,
-                        "--set: expected key=value, got '" << assignment << "'");
+  KUSHNER_INPUT_REQUIRE(eq != std::string::npos && eq > 0, "--set: expected key=value, got '" << assignment << "'");
   return {strip(assignment.substr(0, eq)), assignment.substr(eq + 1)};
 }
 

@@ -64,9 +64,9 @@ class ParameterSetter {
     return parse_parameter_value(name, text_);
   }
   void expect_shape(const ParameterValue& v, int rows, int cols) const {
-    KUSHNER_INPUT_REQUIRE(v.rows == rows && v.cols == cols,
-                          "--set " << key_ << ": expected " << shape_name(rows, cols) << ", got "
-                                   << shape_name(v.rows, v.cols) << " '" << text_ << "'");
+    KUSHNER_INPUT_REQUIRE(v.rows == rows && v.cols == cols, "--set " << key_ << ": expected " << shape_name(rows, cols)
+                                                                     << ", got " << shape_name(v.rows, v.cols) << " '"
+                                                                     << text_ << "'");
   }
   static std::string shape_name(int rows, int cols) {
     if (rows == 1 && cols == 1) return "a number";

@@ -11,8 +11,8 @@
 // q-column model takes). Which filters apply depends on the coefficients, so the model says why a filter
 // cannot run (from `drift_facts()`, checked when filters are selected) instead of the compile-time traits.
 #include "core/small_matrix.hpp"
-#include "models/drift_forms.hpp"
 #include "models/drift_facts.hpp"
+#include "models/drift_forms.hpp"
 #include "models/initial_law.hpp"
 #include "models/polynomial_monomials.hpp"
 

@@ -26,7 +26,8 @@ nlohmann::json describe_models() {
     model.parameters(recorder);
     nlohmann::json parameters = nlohmann::json::array();
     if constexpr (dimension_choice<Model>::selectable)
-      parameters.push_back({{"name", "dim"}, {"default", Model::state_dim}, {"description", "state dimension (1, 2 or 3)"}});
+      parameters.push_back(
+          {{"name", "dim"}, {"default", Model::state_dim}, {"description", "state dimension (1, 2 or 3)"}});
     for (const auto& e : recorder.entries())
       parameters.push_back({{"name", e.name}, {"default", e.value}, {"description", e.description}});
     models.push_back({{"name", Model::name},

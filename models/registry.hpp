@@ -76,8 +76,7 @@ void with_model(const std::string& name, const std::vector<std::string>& sets, F
       dims += (dims.empty() ? "" : ", ") + std::to_string(Model::state_dim);
       if ((dim == 0 ? dimension_choice<Model>::default_dim : dim) != Model::state_dim) return;
     } else {
-      KUSHNER_INPUT_REQUIRE(dim == 0, "--set dim: model '" << name << "' has a fixed dimension "
-                                                             << Model::state_dim);
+      KUSHNER_INPUT_REQUIRE(dim == 0, "--set dim: model '" << name << "' has a fixed dimension " << Model::state_dim);
     }
     Model model;
     apply_parameters(model, assignments);
@@ -86,7 +85,8 @@ void with_model(const std::string& name, const std::vector<std::string>& sets, F
     f(model);
   });
   if (called) return;
-  if (name_known) throw InputError("--set dim: model '" + name + "' supports dim " + dims + " (got " + std::to_string(dim) + ")");
+  if (name_known)
+    throw InputError("--set dim: model '" + name + "' supports dim " + dims + " (got " + std::to_string(dim) + ")");
   std::string known;
   for (const auto& n : model_names()) known += (known.empty() ? "" : ", ") + n;
   throw InputError("--model: unknown model '" + name + "' (known: " + known + ")");

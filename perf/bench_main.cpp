@@ -11,9 +11,10 @@ int main(int argc, char** argv) {
   if (::benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   const kushner::BackendDescription backend = kushner::describe_backend(kushner::available_backends().front());
   ::benchmark::AddCustomContext("kushner", kushner::version_string());
-  ::benchmark::AddCustomContext("backend", backend.name + (backend.device.empty() ? "" : " (" + backend.device + ")") +
-                                               (backend.threads > 0 ? " (" + std::to_string(backend.threads) + " threads)" : "") +
-                                               ", Kokkos " + backend.kokkos);
+  ::benchmark::AddCustomContext(
+      "backend", backend.name + (backend.device.empty() ? "" : " (" + backend.device + ")") +
+                     (backend.threads > 0 ? " (" + std::to_string(backend.threads) + " threads)" : "") + ", Kokkos " +
+                     backend.kokkos);
   ::benchmark::RunSpecifiedBenchmarks();
   ::benchmark::Shutdown();
   return 0;

@@ -3,8 +3,8 @@
 // must move (the memory floor) in the same binary. Observation increments come from a bank of truths that
 // is stepped outside the timed region. With steps = 2 each timed call is ParticleFilterBank::step_pair (two
 // steps, one pass over the particles on a GPU: half the bytes per particle-step).
-#include "engine/truth_bank.hpp"
 #include "engine/particle_filter_bank.hpp"
+#include "engine/truth_bank.hpp"
 #include "models/sine_model.hpp"
 
 #include <benchmark/benchmark.h>
@@ -49,8 +49,10 @@ void BM_ParticleFilterStep(benchmark::State& state) {
     }
     space.fence();
     Kokkos::Timer timer;
-    if (pairs) pf.step_pair(k, dt, first_dy, truth.observations());
-    else pf.step(k, dt, truth.observations());
+    if (pairs)
+      pf.step_pair(k, dt, first_dy, truth.observations());
+    else
+      pf.step(k, dt, truth.observations());
     space.fence();
     state.SetIterationTime(timer.seconds());
     k += pairs ? 2 : 1;
@@ -101,22 +103,26 @@ void BM_StreamCopy(benchmark::State& state) {
 // The third argument (GPU team kernel only) is particles per thread, 0 = the default; the fourth, 0, turns
 // resampling off (ESS threshold 0), which shows what resampling costs; the fifth is steps per timed call
 // (2: step_pair, which fuses them where the team kernel runs).
-BENCHMARK_TEMPLATE(BM_ParticleFilterStep, SineModel)->Apply([](benchmark::internal::Benchmark* b) {
-  b->ArgNames({"members", "particles", "per_thread", "resample", "steps"});
-  b->Args({100, 4096, 0, 1, 1})->Args({1000, 1024, 0, 1, 1})->Args({1000, 16384, 0, 1, 1});
+BENCHMARK_TEMPLATE(BM_ParticleFilterStep, SineModel)
+    ->Apply([](benchmark::internal::Benchmark* b) {
+      b->ArgNames({"members", "particles", "per_thread", "resample", "steps"});
+      b->Args({100, 4096, 0, 1, 1})->Args({1000, 1024, 0, 1, 1})->Args({1000, 16384, 0, 1, 1});
 #if defined(KOKKOS_ENABLE_CUDA)
-  b->Args({1000, 65536, 0, 1, 1})->Args({10000, 65536, 0, 1, 1})->Args({15259, 65536, 0, 1, 1});
-  b->Args({1000, 65536, 8, 1, 1})->Args({1000, 65536, 32, 1, 1})->Args({1000, 65536, 0, 0, 1});
-  b->Args({1000, 65536, 0, 1, 2})->Args({1000, 65536, 0, 0, 2})->Args({1000, 1024, 0, 1, 2});
-  b->Args({1000, 16384, 0, 1, 2})->Args({10000, 65536, 0, 1, 2});
+      b->Args({1000, 65536, 0, 1, 1})->Args({10000, 65536, 0, 1, 1})->Args({15259, 65536, 0, 1, 1});
+      b->Args({1000, 65536, 8, 1, 1})->Args({1000, 65536, 32, 1, 1})->Args({1000, 65536, 0, 0, 1});
+      b->Args({1000, 65536, 0, 1, 2})->Args({1000, 65536, 0, 0, 2})->Args({1000, 1024, 0, 1, 2});
+      b->Args({1000, 16384, 0, 1, 2})->Args({10000, 65536, 0, 1, 2});
 #endif
-})->UseManualTime();
-BENCHMARK_TEMPLATE(BM_StreamCopy, SineModel)->Apply([](benchmark::internal::Benchmark* b) {
-  b->ArgNames({"members", "particles"})->Args({100, 4096})->Args({1000, 1024})->Args({1000, 16384});
+    })
+    ->UseManualTime();
+BENCHMARK_TEMPLATE(BM_StreamCopy, SineModel)
+    ->Apply([](benchmark::internal::Benchmark* b) {
+      b->ArgNames({"members", "particles"})->Args({100, 4096})->Args({1000, 1024})->Args({1000, 16384});
 #if defined(KOKKOS_ENABLE_CUDA)
-  b->Args({1000, 65536})->Args({15259, 65536});
+      b->Args({1000, 65536})->Args({15259, 65536});
 #endif
-})->UseManualTime();
+    })
+    ->UseManualTime();
 
 }  // namespace
 }  // namespace kushner

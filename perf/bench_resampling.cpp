@@ -34,11 +34,11 @@ ResamplingWorkspace<Mem> make_workspace(int n, int members) {
 /// Smooth, uneven weights (a Gaussian bump per member): like a filter's weights before resampling.
 Kokkos::View<double**, Kokkos::LayoutLeft, Mem> make_weights(int n, int members) {
   Kokkos::View<double**, Kokkos::LayoutLeft, Mem> w("weights", n, members);
-  Kokkos::parallel_for("fill", Kokkos::MDRangePolicy<Space, Kokkos::Rank<2>>({0, 0}, {n, members}),
-                       KOKKOS_LAMBDA(int j, int m) {
-                         const double z = (j - 0.4 * n - m % 17) / (0.15 * n);
-                         w(j, m) = math::exp(-0.5 * z * z);
-                       });
+  Kokkos::parallel_for(
+      "fill", Kokkos::MDRangePolicy<Space, Kokkos::Rank<2>>({0, 0}, {n, members}), KOKKOS_LAMBDA(int j, int m) {
+        const double z = (j - 0.4 * n - m % 17) / (0.15 * n);
+        w(j, m) = math::exp(-0.5 * z * z);
+      });
   return w;
 }
 
@@ -59,7 +59,11 @@ void BM_ResampleMembersKokkos(benchmark::State& state) {
   state.counters["particles_per_s"] =
       benchmark::Counter(static_cast<double>(members) * n, benchmark::Counter::kIsIterationInvariantRate);
 }
-BENCHMARK(BM_ResampleMembersKokkos)->ArgNames({"members", "particles"})->Args({100, 4096})->Args({1000, 65536})->UseManualTime();
+BENCHMARK(BM_ResampleMembersKokkos)
+    ->ArgNames({"members", "particles"})
+    ->Args({100, 4096})
+    ->Args({1000, 65536})
+    ->UseManualTime();
 
 #if defined(KOKKOS_ENABLE_CUDA) && defined(KUSHNER_THRUST)
 struct MemberOf {
@@ -87,14 +91,15 @@ void BM_ResampleMembersThrust(benchmark::State& state) {
     const auto cw = ws.cumulative;
     const auto p = points;
     const std::uint32_t s = step++;
-    Kokkos::parallel_for("normalize", Kokkos::RangePolicy<Space>(space, 0, total), KOKKOS_LAMBDA(long i) {
-      const int m = static_cast<int>(i / n), j = static_cast<int>(i % n);
-      p(i) = m + (j + detail::resampling_uniform(7, m, 0, s)) / n;
-      cw(j, m) = m + cw(j, m) / cw(n - 1, m);
-    });
+    Kokkos::parallel_for(
+        "normalize", Kokkos::RangePolicy<Space>(space, 0, total), KOKKOS_LAMBDA(long i) {
+          const int m = static_cast<int>(i / n), j = static_cast<int>(i % n);
+          p(i) = m + (j + detail::resampling_uniform(7, m, 0, s)) / n;
+          cw(j, m) = m + cw(j, m) / cw(n - 1, m);
+        });
     space.fence();
-    Kokkos::parallel_for("fix_totals", Kokkos::RangePolicy<Space>(space, 0, members),
-                         KOKKOS_LAMBDA(int m) { cw(n - 1, m) = m + 1.0; });
+    Kokkos::parallel_for(
+        "fix_totals", Kokkos::RangePolicy<Space>(space, 0, members), KOKKOS_LAMBDA(int m) { cw(n - 1, m) = m + 1.0; });
     space.fence();
     thrust::upper_bound(thrust::device, thrust::device_ptr<double>(c), thrust::device_ptr<double>(c) + total,
                         thrust::device_ptr<double>(points.data()), thrust::device_ptr<double>(points.data()) + total,
@@ -105,7 +110,11 @@ void BM_ResampleMembersThrust(benchmark::State& state) {
   state.counters["particles_per_s"] =
       benchmark::Counter(static_cast<double>(members) * n, benchmark::Counter::kIsIterationInvariantRate);
 }
-BENCHMARK(BM_ResampleMembersThrust)->ArgNames({"members", "particles"})->Args({100, 4096})->Args({1000, 65536})->UseManualTime();
+BENCHMARK(BM_ResampleMembersThrust)
+    ->ArgNames({"members", "particles"})
+    ->Args({100, 4096})
+    ->Args({1000, 65536})
+    ->UseManualTime();
 #endif
 
 }  // namespace

@@ -1,6 +1,6 @@
 // GoogleTest main for kushner's tests: Kokkos is initialized once for the whole binary.
-#include <Kokkos_Core.hpp>
 #include <gtest/gtest.h>
+#include <Kokkos_Core.hpp>
 
 #include <cstdlib>
 

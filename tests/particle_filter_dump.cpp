@@ -5,8 +5,8 @@
 // instead (no process noise: tan drift, deterministic particles between resamplings), for looking at how a
 // GPU run departs from a host one.
 #include "engine/backend.hpp"
-#include "engine/truth_bank.hpp"
 #include "engine/particle_filter_bank.hpp"
+#include "engine/truth_bank.hpp"
 #include "models/car_model.hpp"
 #include "models/cubic_oscillator_model.hpp"
 #include "models/linear_model.hpp"
@@ -53,7 +53,8 @@ int main(int argc, char** argv) {
       return;
     }
     kushner::dump<Space>("sine", kushner::SineModel{}, 24, 3000, 300, 1e-2, kushner::ResamplingScheme::systematic);
-    kushner::dump<Space>("linear2", kushner::LinearModel<2>{}, 10, 1500, 200, 1e-2, kushner::ResamplingScheme::stratified);
+    kushner::dump<Space>("linear2", kushner::LinearModel<2>{}, 10, 1500, 200, 1e-2,
+                         kushner::ResamplingScheme::stratified);
     kushner::CubicOscillatorModel cubic;
     cubic.set_initial_law(kushner::Vec<2>{{1.0, 0.5}}, kushner::Mat<2, 2>::diagonal(0.1));
     kushner::dump<Space>("cubic", cubic, 7, 2000, 200, 1e-2, kushner::ResamplingScheme::residual);

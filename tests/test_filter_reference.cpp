@@ -18,9 +18,11 @@ using MemSpace = Space::memory_space;
 class ShiftedTruth : public ReferenceEstimator<MemSpace> {
  public:
   ShiftedTruth(BankVector<MemSpace> truth, double offset)
-      : truth_(truth), mean_("shifted_truth", truth.extent(0), truth.extent(1)),
+      : truth_(truth),
+        mean_("shifted_truth", truth.extent(0), truth.extent(1)),
         covariance_("shifted_truth_cov", truth.extent(0), packed_size(static_cast<int>(truth.extent(1)))),
-        status_("shifted_truth_status", truth.extent(0)), offset_(offset) {
+        status_("shifted_truth_status", truth.extent(0)),
+        offset_(offset) {
     Kokkos::deep_copy(covariance_, 1.0);  // a 1-D bank: P = 1
     copy();
   }

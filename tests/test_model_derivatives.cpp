@@ -21,19 +21,23 @@ void expect_derivatives_match_central_differences(const Model& model, const Vec<
     xm[j] -= h;
     const auto df = (model.drift(t, xp, u) - model.drift(t, xm, u)) * (0.5 / h);
     const auto dh = (model.observation(t, xp) - model.observation(t, xm)) * (0.5 / h);
-    for (int i = 0; i < n; ++i) EXPECT_NEAR(J(i, j), df[i], 1e-6 * (1 + std::abs(df[i]))) << Model::name << " df" << i << "/dx" << j;
-    for (int i = 0; i < p; ++i) EXPECT_NEAR(H(i, j), dh[i], 1e-6 * (1 + std::abs(dh[i]))) << Model::name << " dh" << i << "/dx" << j;
+    for (int i = 0; i < n; ++i)
+      EXPECT_NEAR(J(i, j), df[i], 1e-6 * (1 + std::abs(df[i]))) << Model::name << " df" << i << "/dx" << j;
+    for (int i = 0; i < p; ++i)
+      EXPECT_NEAR(H(i, j), dh[i], 1e-6 * (1 + std::abs(dh[i]))) << Model::name << " dh" << i << "/dx" << j;
     for (int k = 0; k < n; ++k) {  // Hessian column j of drift component k from differences of the Jacobian
       const auto hess = model.drift_hessian(t, x, u, k);
       const auto dJ = (model.drift_jacobian(t, xp, u) - model.drift_jacobian(t, xm, u)) * (0.5 / h);
       for (int i = 0; i < n; ++i)
-        EXPECT_NEAR(hess(i, j), dJ(k, i), 1e-5 * (1 + std::abs(dJ(k, i)))) << Model::name << " d2f" << k << "/dx" << i << "dx" << j;
+        EXPECT_NEAR(hess(i, j), dJ(k, i), 1e-5 * (1 + std::abs(dJ(k, i))))
+            << Model::name << " d2f" << k << "/dx" << i << "dx" << j;
     }
     for (int k = 0; k < p; ++k) {
       const auto hess = model.observation_hessian(t, x, k);
       const auto dH = (model.observation_jacobian(t, xp) - model.observation_jacobian(t, xm)) * (0.5 / h);
       for (int i = 0; i < n; ++i)
-        EXPECT_NEAR(hess(i, j), dH(k, i), 1e-5 * (1 + std::abs(dH(k, i)))) << Model::name << " d2h" << k << "/dx" << i << "dx" << j;
+        EXPECT_NEAR(hess(i, j), dH(k, i), 1e-5 * (1 + std::abs(dH(k, i))))
+            << Model::name << " d2h" << k << "/dx" << i << "dx" << j;
     }
   }
 }

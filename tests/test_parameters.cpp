@@ -56,15 +56,17 @@ std::string error_of(const std::string& name, const std::vector<std::string>& se
 }
 
 TEST(Registry, RefusesBadInputWithOneClearMessage) {
-  EXPECT_EQ(error_of("sin", {}), "--model: unknown model 'sin' (known: benes, car, car-taylor3, clark-linear, cubic-oscillator, linear, ou, "
+  EXPECT_EQ(error_of("sin", {}),
+            "--model: unknown model 'sin' (known: benes, car, car-taylor3, clark-linear, cubic-oscillator, linear, ou, "
             "sine, terpolymer)");
   EXPECT_NE(error_of("sine", {"z=1"}).find("model 'sine' has no parameter 'z' (known: q, r,"), std::string::npos);
   EXPECT_NE(error_of("sine", {"q"}).find("expected key=value"), std::string::npos);
   EXPECT_NE(error_of("linear", {"dim=4"}).find("supports dim 1, 2, 3"), std::string::npos);
   EXPECT_NE(error_of("sine", {"dim=2"}).find("fixed dimension"), std::string::npos);
   EXPECT_NE(error_of("linear", {"A=1,2"}).find("expected a 2x2 matrix"), std::string::npos);
-  EXPECT_NE(error_of("linear", {"prior_cov=1,2;2,1"}).find("prior_cov: not positive semidefinite (smallest eigenvalue -1"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of("linear", {"prior_cov=1,2;2,1"}).find("prior_cov: not positive semidefinite (smallest eigenvalue -1"),
+      std::string::npos);
   EXPECT_EQ(error_of("linear", {"x0_cov=1,2;3,4"}), "x0_cov: not symmetric");
   EXPECT_NE(error_of("sine", {"r=0"}).find("observation noise R R^T: not positive definite"), std::string::npos);
   EXPECT_NE(error_of("clark-linear", {"bound_w=-1"}).find("bound_w, bound_v: must be positive"), std::string::npos);

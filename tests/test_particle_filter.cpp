@@ -1,7 +1,7 @@
 // The particle-filter bank: one step against a hand computation, resampling bookkeeping, a diverged member
 // staying isolated, and the GPU's team kernel (run here on the host) against the host's SIMD block kernel.
-#include "engine/truth_bank.hpp"
 #include "engine/particle_filter_bank.hpp"
+#include "engine/truth_bank.hpp"
 #include "models/cubic_oscillator_model.hpp"
 #include "models/sine_model.hpp"
 #include "tests/test_spaces.hpp"
@@ -210,7 +210,8 @@ TEST(ParticleFilterBank, TeamKernelResumsWhenTheWeightBoundIsFarOff) {
     for (int m = 0; m < members; ++m) {
       ASSERT_EQ(p.status()(m), Status::ok) << which << " step " << k << " member " << m;
       const double mean = pb.posterior_mean()(m, 0), cov = pb.posterior_covariance()(m, 0);
-      EXPECT_NEAR(p.posterior_mean()(m, 0), mean, 1e-12 * (1 + std::abs(mean))) << which << " step " << k << " member " << m;
+      EXPECT_NEAR(p.posterior_mean()(m, 0), mean, 1e-12 * (1 + std::abs(mean)))
+          << which << " step " << k << " member " << m;
       EXPECT_NEAR(p.posterior_covariance()(m, 0), cov, 1e-12 * cov) << which << " step " << k << " member " << m;
       EXPECT_NEAR(p.effective_sample_size()(m), pb.effective_sample_size()(m), 1e-10 * pb.effective_sample_size()(m))
           << which << " step " << k << " member " << m;
@@ -220,8 +221,8 @@ TEST(ParticleFilterBank, TeamKernelResumsWhenTheWeightBoundIsFarOff) {
       for (int j = 0; j < particles; ++j) {
         const double want = pb.log_weights()(j, m) - pb.log_normalizer()(m);
         const double got = p.log_weights()(j, m) - p.log_normalizer()(m);
-        const double excess = std::abs(got - want) - 1e-12 * (1 + std::abs(pb.log_weights()(j, m)) +
-                                                               std::abs(pb.log_normalizer()(m)));
+        const double excess =
+            std::abs(got - want) - 1e-12 * (1 + std::abs(pb.log_weights()(j, m)) + std::abs(pb.log_normalizer()(m)));
         if (excess > worst_excess) worst_excess = excess, worst = j;
       }
       EXPECT_LE(worst_excess, 0.0) << which << " step " << k << " member " << m << " particle " << worst;
@@ -285,8 +286,8 @@ TEST(ParticleFilterBank, StepPairMatchesTwoSteps) {
   ASSERT_FALSE(unfused.fuses_step_pairs());
   BankVector<Kokkos::HostSpace> first_dy("first_dy", members, 1);
   auto current = [](const Bank& pf) {
-    return copy_posterior(pf, Bank::PosteriorViews{pf.posterior_mean(), pf.posterior_covariance(),
-                                                   pf.effective_sample_size()});
+    return copy_posterior(
+        pf, Bank::PosteriorViews{pf.posterior_mean(), pf.posterior_covariance(), pf.effective_sample_size()});
   };
   int redone_pairs = 0;
   for (int k = 0; k < steps; k += 2) {

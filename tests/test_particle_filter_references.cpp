@@ -22,9 +22,9 @@ constexpr double dt = 0.01;
 const std::vector<double> particle_counts = {256, 1024, 4096, 16384};
 
 struct Convergence {
-  std::vector<double> rms;          // per particle count
+  std::vector<double> rms;  // per particle count
   double slope;
-  std::vector<test::Bias> bias;     // per component, at the largest count
+  std::vector<test::Bias> bias;  // per component, at the largest count
   std::vector<test::Bias> wrong_bias;
   double wrong_slope;
 };

@@ -24,7 +24,8 @@ TEST(ParticleSnapshot, PriorQuantilesAndHistogramMatchTheGaussianWithinFourStand
   const auto q = snap.quantiles(2, 0, {0.5, phi1, 1.0 - phi1});
   // SE of a sample p-quantile: sqrt(p (1 - p) / N) / f(x_p), f the density there.
   const double pdf0 = 1.0 / (sd * std::sqrt(2 * M_PI)), pdf1 = pdf0 * std::exp(-0.5);
-  const double se_median = std::sqrt(0.25 / particles) / pdf0, se_tail = std::sqrt(phi1 * (1 - phi1) / particles) / pdf1;
+  const double se_median = std::sqrt(0.25 / particles) / pdf0,
+               se_tail = std::sqrt(phi1 * (1 - phi1) / particles) / pdf1;
   EXPECT_NEAR(q[0], 1.0, 4 * se_median);
   EXPECT_NEAR(q[1], 1.0 + sd, 4 * se_tail);
   EXPECT_NEAR(q[2], 1.0 - sd, 4 * se_tail);
@@ -32,7 +33,7 @@ TEST(ParticleSnapshot, PriorQuantilesAndHistogramMatchTheGaussianWithinFourStand
   const auto h = snap.histogram(2, 0, 1.0 - 4 * sd, 1.0 + 4 * sd, 40);
   double mass = 0.0;
   for (double d : h) mass += d * (8 * sd / 40);
-  EXPECT_NEAR(mass, 1.0, 1e-3);  // P(|Z| > 4) = 6e-5
+  EXPECT_NEAR(mass, 1.0, 1e-3);                           // P(|Z| > 4) = 6e-5
   const double bin = 8 * sd / 40, p_center = pdf0 * bin;  // the two bins around the mean
   const double se_bin = std::sqrt(p_center * (1 - p_center) / particles) / bin;
   EXPECT_NEAR(0.5 * (h[19] + h[20]), pdf0, 4 * se_bin + 0.02 * pdf0);  // + curvature of the pdf over a bin
@@ -73,7 +74,7 @@ TEST(ParticleSnapshot, ChosenMembersHoldTheSameParticlesAsTheWholeBank) {
       EXPECT_EQ(chosen.histogram(m, i, -2.0, 4.0, 12), whole.histogram(m, i, -2.0, 4.0, 12)) << m << " " << i;
     }
   EXPECT_NE(whole.quantiles(1, 0, {0.5}), whole.quantiles(3, 0, {0.5}));  // distinct members, distinct draws
-  EXPECT_THROW(chosen.quantiles(0, 0, {0.5}), std::logic_error);  // member 0 was not copied
+  EXPECT_THROW(chosen.quantiles(0, 0, {0.5}), std::logic_error);          // member 0 was not copied
 }
 
 static_assert(std::is_same_v<exact_reference_t<Space, LinearModel<2>>, KalmanBucyReference<Space, 2>>);

@@ -18,7 +18,8 @@ constexpr std::uint32_t seed = 20261122;
 /// A fixed, uneven weight vector: a few heavy particles, many light ones, some exactly zero.
 std::vector<double> fixed_weights(int n) {
   std::vector<double> w(n);
-  for (int j = 0; j < n; ++j) w[j] = (j % 7 == 3) ? 0.0 : 0.05 + std::pow(std::sin(0.37 * j + 0.2), 4) + (j % 11 == 0 ? 3.0 : 0.0);
+  for (int j = 0; j < n; ++j)
+    w[j] = (j % 7 == 3) ? 0.0 : 0.05 + std::pow(std::sin(0.37 * j + 0.2), 4) + (j % 11 == 0 ? 3.0 : 0.0);
   return w;
 }
 
@@ -81,8 +82,10 @@ double worst_z(const OffspringStatistics& st, const std::vector<double>& w) {
   for (int j = 0; j < n; ++j) {
     const double expected = n * w[j] / total;
     const double diff = std::abs(st.mean[j] - expected);
-    if (st.standard_error[j] > 0.0) worst = std::max(worst, diff / st.standard_error[j]);
-    else if (diff > 1e-9) worst = std::max(worst, 1e9);
+    if (st.standard_error[j] > 0.0)
+      worst = std::max(worst, diff / st.standard_error[j]);
+    else if (diff > 1e-9)
+      worst = std::max(worst, 1e9);
   }
   return worst;
 }
@@ -172,7 +175,9 @@ template <class Mem>
 struct ExponentiatedWeights {
   Kokkos::View<double**, Kokkos::LayoutLeft, Mem> l, w;
   BankScalar<double, Mem> log_normalizer;
-  KOKKOS_INLINE_FUNCTION void operator()(const int j, const int m) const { w(j, m) = math::exp(l(j, m) - log_normalizer(m)); }
+  KOKKOS_INLINE_FUNCTION void operator()(const int j, const int m) const {
+    w(j, m) = math::exp(l(j, m) - log_normalizer(m));
+  }
 };
 
 template <class Space>
@@ -241,7 +246,8 @@ void check_chunked_against_team_path(int n, int members, const std::vector<int>&
     for (int s = 0; s < n; ++s) {
       const int a = resampled ? expected(s, m) : s;
       if (resampled && ancestors(s, m) != a) ++mismatches;
-      if (resampled) EXPECT_NE(l(a, m), -std::numeric_limits<double>::infinity()) << "dead particle drawn, member " << m;
+      if (resampled)
+        EXPECT_NE(l(a, m), -std::numeric_limits<double>::infinity()) << "dead particle drawn, member " << m;
       EXPECT_EQ(x_after(s, m, 0), x(a, m, 0));
       EXPECT_EQ(x_after(s, m, 1), x(a, m, 1));
       EXPECT_EQ(l_after(s, m), resampled ? 0.0 : l(s, m));

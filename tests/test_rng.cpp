@@ -69,7 +69,7 @@ TYPED_TEST(PhiloxNormals, KolmogorovSmirnovAcceptsNormalAndRejectsScaledNormal) 
 }
 
 TEST(PhiloxStreams, DistinctStreamsShareNoBlockAndAreUncorrelated) {
-  const std::vector<Stream> streams = {Stream::truth_initial,    Stream::process_noise, Stream::observation_noise,
+  const std::vector<Stream> streams = {Stream::truth_initial,    Stream::process_noise,  Stream::observation_noise,
                                        Stream::particle_initial, Stream::particle_noise, Stream::resampling};
   constexpr int blocks = 1 << 16;
   std::set<std::uint64_t> seen;

@@ -1,7 +1,7 @@
 #pragma once
 // The execution spaces this build turns on, for TYPED_TESTs that must hold on every backend.
-#include <Kokkos_Core.hpp>
 #include <gtest/gtest.h>
+#include <Kokkos_Core.hpp>
 
 namespace kushner::test {
 

@@ -37,7 +37,8 @@ TEST(OuEnsemble, MeanAndVarianceAtOneWithinFourStandardErrors) {
   const double se_mean = std::sqrt(exact.variance / num_members);
   const double se_variance = exact.variance * std::sqrt(2.0 / (num_members - 1));
   EXPECT_LT(std::abs(mean - exact.mean), 4.0 * se_mean) << "mean " << mean << " exact " << exact.mean;
-  EXPECT_LT(std::abs(variance - exact.variance), 4.0 * se_variance) << "variance " << variance << " exact " << exact.variance;
+  EXPECT_LT(std::abs(variance - exact.variance), 4.0 * se_variance)
+      << "variance " << variance << " exact " << exact.variance;
 
   OuModel off = model;  // power: a 10% error in theta must show
   off.theta = 1.1;
@@ -102,9 +103,11 @@ TEST(LinearEnsemble, TwoDimensionalMeanAndCovarianceWithinFourStandardErrors) {
   const auto [exact_mean, exact_cov] = linear_exact(model, 1.0);
   for (int i = 0; i < 2; ++i) {
     const double se = std::sqrt(exact_cov(i, i) / num_members);
-    EXPECT_LT(std::abs(mean(i) - exact_mean(i)), 4.0 * se) << "mean " << i << ": " << mean(i) << " exact " << exact_mean(i);
+    EXPECT_LT(std::abs(mean(i) - exact_mean(i)), 4.0 * se)
+        << "mean " << i << ": " << mean(i) << " exact " << exact_mean(i);
     for (int j = 0; j <= i; ++j) {  // Var of a sample covariance entry of a Gaussian: (P_ii P_jj + P_ij^2) / M
-      const double se_cov = std::sqrt((exact_cov(i, i) * exact_cov(j, j) + exact_cov(i, j) * exact_cov(i, j)) / num_members);
+      const double se_cov =
+          std::sqrt((exact_cov(i, i) * exact_cov(j, j) + exact_cov(i, j) * exact_cov(i, j)) / num_members);
       EXPECT_LT(std::abs(cov(i, j) - exact_cov(i, j)), 4.0 * se_cov)
           << "cov(" << i << "," << j << "): " << cov(i, j) << " exact " << exact_cov(i, j);
     }

@@ -1,8 +1,8 @@
 // `kushner reproduce basin-car-filter`: seed 002's automotive filter tables (L1505-1523).
 #include "drivers/filter_command_impl.hpp"
+#include "drivers/reproduce/reproduce_examples.hpp"
 #include "engine/printed_car_filter.hpp"
 #include "engine/prior_line_reference.hpp"
-#include "drivers/reproduce/reproduce_examples.hpp"
 #include "models/car_model.hpp"
 #include "models/sine_observation_noise.hpp"
 

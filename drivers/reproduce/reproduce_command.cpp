@@ -1,12 +1,12 @@
 // `kushner reproduce NAME --out DIR`: the seeds' worked examples run by the engine, with a table that puts the
 // paper's numbers next to ours (drivers/reproduce/reproduction_table.hpp).
-#include "engine/backend.hpp"
+#include "core/errors.hpp"
 #include "drivers/commands.hpp"
 #include "drivers/csv.hpp"
 #include "drivers/filter_command_impl.hpp"
 #include "drivers/reproduce/reproduce_examples.hpp"
 #include "drivers/reproduce/reproduce_options.hpp"
-#include "core/errors.hpp"
+#include "engine/backend.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -223,7 +223,9 @@ int run_reproduce(const ReproduceOptions& options, const RunContext& context_in)
   bool figures = settings.plots && summary.value("plots", true);
   for (const auto& run : result.runs) figures = figures && summary["runs"][run].value("plots", false);
   std::printf("written to %s/ (reproduction.csv, reproduction.md%s)\n", options.out.c_str(),
-              figures ? ", report.md, plots, CSV, JSON" : settings.plots ? ", report.md, CSV, JSON" : ", CSV, JSON");
+              figures          ? ", report.md, plots, CSV, JSON"
+              : settings.plots ? ", report.md, CSV, JSON"
+                               : ", CSV, JSON");
   return 0;
 }
 

@@ -1,7 +1,7 @@
 #include "drivers/reproduce/reproduction_table.hpp"
 
-#include "drivers/csv.hpp"
 #include "core/errors.hpp"
+#include "drivers/csv.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -13,8 +13,8 @@
 // The pre-pass (prepare) runs the truths with ASRE alone, recording per member and iterate the largest change
 // max_t |m^[i](t) - m^[i-1](t)|_inf (`change`), and picks each member's first iterate below the tolerance;
 // the run then reports that iterate.
-#include "kernels/bank.hpp"
 #include "core/errors.hpp"
+#include "kernels/bank.hpp"
 #include "kernels/filters/filter_protocol.hpp"
 #include "kernels/filters/jacobian_linearization.hpp"
 #include "models/model_traits.hpp"

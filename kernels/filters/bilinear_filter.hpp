@@ -5,8 +5,8 @@
 //   dP   = (J P + P J^T + b b^T - P A^T V^{-1} A P) dt,   J = a1 + 2 a2 m  (a2 symmetric in i, j).
 #include "kernels/filters/filter_protocol.hpp"
 #include "kernels/filters/jacobian_linearization.hpp"
-#include "models/model_traits.hpp"
 #include "kernels/filters/polynomial_moments.hpp"
+#include "models/model_traits.hpp"
 
 namespace kushner {
 

@@ -22,7 +22,7 @@ struct FilterBankStep {
                 "FilterBankStep: the truths' model and the filters' model must have the same dimensions");
   EulerMaruyamaTruthStep<TruthModel, MemSpace> truth;
   Model model;
-  BankScalar<Status, MemSpace> truth_status;      // non_finite once a truth escaped: not filtered, not scored
+  BankScalar<Status, MemSpace> truth_status;  // non_finite once a truth escaped: not filtered, not scored
   FilterSlots<MemSpace, Filters...> slots;
   bool record;  // the step ends at an output time: fill the snapshots
 

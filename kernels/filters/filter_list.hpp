@@ -93,9 +93,8 @@ std::vector<std::string> supported_filters(const Model& model) {
 /// Every filter name, in report order (names do not depend on the model).
 inline std::vector<std::string> all_filter_names() {
   std::vector<std::string> names;
-  for_each_filter_type<LinearModel<1>, Kokkos::HostSpace>([&](auto* tag) {
-    names.push_back(std::remove_pointer_t<decltype(tag)>::name);
-  });
+  for_each_filter_type<LinearModel<1>, Kokkos::HostSpace>(
+      [&](auto* tag) { names.push_back(std::remove_pointer_t<decltype(tag)>::name); });
   return names;
 }
 

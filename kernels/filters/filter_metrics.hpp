@@ -2,10 +2,10 @@
 // Per-member metric kernels behind the bank's reports: time averages of the accumulated errors (NaN for a
 // member that is not scored, so that ensemble_moments leaves it out and counts it) and status counts.
 // Integer counts are order-independent, so a parallel_reduce keeps them deterministic.
-#include "kernels/bank.hpp"
-#include "kernels/filters/filter_slot.hpp"
 #include "core/math.hpp"
 #include "core/status.hpp"
+#include "kernels/bank.hpp"
+#include "kernels/filters/filter_slot.hpp"
 
 #include <Kokkos_Core.hpp>
 

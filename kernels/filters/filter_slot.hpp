@@ -2,9 +2,9 @@
 // One filter's part of the bank: its estimates m, covariances P (packed symmetric: symmetric by
 // construction), per-member status, and the per-member error accumulators the run's metrics come from.
 // advance() is what the bank's fused step kernel does for one member and one filter.
+#include "core/status.hpp"
 #include "kernels/bank.hpp"
 #include "kernels/filters/filter_step.hpp"
-#include "core/status.hpp"
 
 #include <Kokkos_Core.hpp>
 

@@ -9,8 +9,8 @@
 //                state dimension <= 3.
 #include "kernels/filters/filter_step.hpp"
 #include "kernels/filters/gauss_hermite.hpp"
-#include "models/model_traits.hpp"
 #include "kernels/filters/polynomial_moments.hpp"
+#include "models/model_traits.hpp"
 
 namespace kushner {
 

@@ -8,8 +8,8 @@
 // filters compute it.
 #include "kernels/filters/filter_protocol.hpp"
 #include "kernels/filters/linearized_kalman_bucy_filter.hpp"
-#include "models/model_traits.hpp"
 #include "kernels/filters/polynomial_moments.hpp"
+#include "models/model_traits.hpp"
 
 namespace kushner {
 

@@ -9,8 +9,8 @@
 // Lower-degree drifts are the special cases with vanishing coefficients (002 L1428).
 #include "kernels/filters/filter_protocol.hpp"
 #include "kernels/filters/jacobian_linearization.hpp"
-#include "models/model_traits.hpp"
 #include "kernels/filters/polynomial_moments.hpp"
+#include "models/model_traits.hpp"
 
 namespace kushner {
 

@@ -4,8 +4,8 @@
 // with a, B, h1, H2 the Gaussian expectations of kernels/filters/gaussian_expectations.hpp and W = G(m) G(m)^T
 // (the paper's noise is state-independent, as in every model here).
 #include "core/errors.hpp"
-#include "kernels/filters/gauss_hermite.hpp"
 #include "kernels/filters/filter_protocol.hpp"
+#include "kernels/filters/gauss_hermite.hpp"
 #include "kernels/filters/gaussian_expectations.hpp"
 #include "kernels/filters/jacobian_linearization.hpp"
 
@@ -58,9 +58,9 @@ struct QuasiLinearFilter {
       return OptionProblem{"qlf_expectations", std::string("model '") + Model::name +
                                                    "' has no closed-form Gaussian expectations (use cubature)"};
     if (requested == "cubature" && !has_cubature)
-      return OptionProblem{"qlf_expectations", "cubature is limited to state_dim <= " +
-                                                   std::to_string(max_cubature_dim) + " (model '" + Model::name +
-                                                   "' has " + std::to_string(n) + ")"};
+      return OptionProblem{"qlf_expectations",
+                           "cubature is limited to state_dim <= " + std::to_string(max_cubature_dim) + " (model '" +
+                               Model::name + "' has " + std::to_string(n) + ")"};
     return std::nullopt;
   }
 

@@ -16,9 +16,9 @@
 // The sums are the ones blocked_inclusive_scan and resample_member compute (same blocks, same sequential
 // order, same expressions), so the indices are the same as the one-team path's on every backend; the test
 // ChunkedSystematic.MatchesTheTeamPathAndMovesTheParticles (tests/test_resampling.cpp) checks it.
-#include "kernels/bank.hpp"
 #include "core/errors.hpp"
 #include "core/math.hpp"
+#include "kernels/bank.hpp"
 #include "kernels/particle_filter/blocked_scan.hpp"
 #include "kernels/particle_filter/resampling.hpp"
 #include "kernels/particle_filter/tuning.hpp"
@@ -45,7 +45,7 @@ template <class MemSpace>
 struct ChunkedResampleData {
   ParticleBank<MemSpace> x, x_scratch;
   Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> log_weight;
-  Kokkos::View<int**, Kokkos::LayoutLeft, MemSpace> ancestors;    // a_s, kept for inspection and tests
+  Kokkos::View<int**, Kokkos::LayoutLeft, MemSpace> ancestors;      // a_s, kept for inspection and tests
   Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> block_sums;  // (scan block, member)
   BankScalar<double, MemSpace> log_normalizer;
   Kokkos::View<int*, MemSpace> members;  // the members to resample: entries [0, member_count())
@@ -165,13 +165,13 @@ struct ChunkedScanPass {
   KOKKOS_INLINE_FUNCTION void operator()(const Team& team) const {
     const int n = d.num_particles;
     const Scratch w(team.team_scratch(0), weights_size(n)), offsets(team.team_scratch(0), resample_chunk_blocks(n));
-    detail::for_each_weight_block<Cumulative>(team, d, w, offsets, [&](int member, int b, int begin, int lo, int hi,
-                                                                        double offset) {
-      if constexpr (Cumulative)
-        detail::add_in_order(w, lo, hi, offset, [&](int j, double c) { d.log_weight(begin + j, member) = c; });
-      else
-        d.block_sums(b, member) = detail::add_in_order(w, lo, hi, 0.0, [](int, double) {});
-    });
+    detail::for_each_weight_block<Cumulative>(
+        team, d, w, offsets, [&](int member, int b, int begin, int lo, int hi, double offset) {
+          if constexpr (Cumulative)
+            detail::add_in_order(w, lo, hi, offset, [&](int j, double c) { d.log_weight(begin + j, member) = c; });
+          else
+            d.block_sums(b, member) = detail::add_in_order(w, lo, hi, 0.0, [](int, double) {});
+        });
   }
 };
 

@@ -9,7 +9,7 @@ namespace kushner {
 
 template <int N, class MemSpace>
 struct CopyListedMembers {
-  ParticleBank<MemSpace> from_x, to_x;                                   // (particle, member, i)
+  ParticleBank<MemSpace> from_x, to_x;                                  // (particle, member, i)
   Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> from_lw, to_lw;  // (particle, member)
   Kokkos::View<const int*, MemSpace> members;
   Kokkos::View<const int, MemSpace> member_count;
@@ -29,8 +29,7 @@ struct CopyListedMembers {
 /// to <- from for the members listed in members(0 .. member_count() - 1). No fence.
 template <int N, class ExecSpace, class MemSpace = typename ExecSpace::memory_space>
 void copy_listed_members(const ExecSpace& space, const CopyListedMembers<N, MemSpace>& copy) {
-  Kokkos::parallel_for("kushner::copy_listed_members", Kokkos::RangePolicy<ExecSpace>(space, 0, copy.work_items),
-                       copy);
+  Kokkos::parallel_for("kushner::copy_listed_members", Kokkos::RangePolicy<ExecSpace>(space, 0, copy.work_items), copy);
 }
 
 }  // namespace kushner

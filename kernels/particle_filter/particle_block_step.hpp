@@ -62,7 +62,7 @@ KUSHNER_SAME_CODE_FOR_ALL_CALLERS void particle_block_host(const ParticleStepDat
       u[2 * k + 1] = u1;
     }
   }
-KUSHNER_SIMD
+  KUSHNER_SIMD
   for (int j = 0; j < count; ++j) {
     Vec<n> xj;
     Vec<K> zj;
@@ -79,21 +79,21 @@ KUSHNER_SIMD
     l[j] = lj;
   }
   double m = -positive_infinity();
-KUSHNER_SIMD_REDUCTION(max : m)
+  KUSHNER_SIMD_REDUCTION(max : m)
   for (int j = 0; j < count; ++j) m = l[j] > m ? l[j] : m;
 
   WeightedMoments<n> w = WeightedMoments<n>::empty();
   if (m > -positive_infinity()) {
     const Vec<n> ref = load<n>(d.reference, member);
     w.max_log_weight = m;
-KUSHNER_SIMD
+    KUSHNER_SIMD
     for (int j = 0; j < count; ++j) {
       e[j] = math::exp(l[j] - m);
       KUSHNER_UNROLL_FULLY
       for (int i = 0; i < n; ++i) dx[i][j] = e[j] > 0.0 ? xs[i][j] - ref[i] : 0.0;
     }
     double s = 0.0, s2 = 0.0;
-KUSHNER_SIMD_REDUCTION(+ : s, s2)
+    KUSHNER_SIMD_REDUCTION(+ : s, s2)
     for (int j = 0; j < count; ++j) {
       s += e[j];
       s2 += e[j] * e[j];
@@ -102,12 +102,12 @@ KUSHNER_SIMD_REDUCTION(+ : s, s2)
     w.sum_weight_sq = s2;
     for (int i = 0; i < n; ++i) {
       double sx = 0.0;
-KUSHNER_SIMD_REDUCTION(+ : sx)
+      KUSHNER_SIMD_REDUCTION(+ : sx)
       for (int j = 0; j < count; ++j) sx += e[j] * dx[i][j];
       w.sum_dx[i] = sx;
       for (int k = i; k < n; ++k) {
         double sxx = 0.0;
-KUSHNER_SIMD_REDUCTION(+ : sxx)
+        KUSHNER_SIMD_REDUCTION(+ : sxx)
         for (int j = 0; j < count; ++j) sxx += e[j] * dx[i][j] * dx[k][j];
         w.sum_dxdx[packed_index(n, i, k)] = sxx;
       }
@@ -127,8 +127,10 @@ struct ParticleBlockStep {
       WeightedMoments<Model::state_dim>::empty().store(d.partials, block, member);
       return;
     }
-    if (d.initialize) particle_block_host<true>(d, member, block);
-    else particle_block_host<false>(d, member, block);
+    if (d.initialize)
+      particle_block_host<true>(d, member, block);
+    else
+      particle_block_host<false>(d, member, block);
   }
 };
 

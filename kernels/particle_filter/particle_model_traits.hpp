@@ -15,9 +15,8 @@ namespace kushner {
 template <class Model, class = void>
 struct has_exact_transition : std::false_type {};
 template <class Model>
-struct has_exact_transition<
-    Model, std::void_t<decltype(std::declval<const Model&>().sample_exact_transition(
-               0.0, std::declval<const Vec<Model::state_dim>&>(), 0.0,
-               std::declval<const Vec<Model::noise_dim>&>(), 0.0))>> : std::true_type {};
+struct has_exact_transition<Model, std::void_t<decltype(std::declval<const Model&>().sample_exact_transition(
+                                       0.0, std::declval<const Vec<Model::state_dim>&>(), 0.0,
+                                       std::declval<const Vec<Model::noise_dim>&>(), 0.0))>> : std::true_type {};
 
 }  // namespace kushner

@@ -2,9 +2,9 @@
 // Per member: merge the block partials of a step in block order (fixed, so the same bits on any number of
 // threads), and turn them into the posterior mean and covariance, the effective sample size
 // ESS = (sum w)^2 / sum w^2 (Kong, Liu & Wong 1994), the log-normalizer, and the decision to resample.
+#include "core/status.hpp"
 #include "kernels/bank.hpp"
 #include "kernels/particle_filter/weighted_moments.hpp"
-#include "core/status.hpp"
 
 #include <Kokkos_Core.hpp>
 
@@ -15,15 +15,15 @@ struct ParticlePosterior {
   static constexpr int packed = packed_size(N);
   Kokkos::View<const double***, Kokkos::LayoutLeft, MemSpace> partials;  // (block, member, k)
   int num_blocks;
-  BankVector<MemSpace> reference;       // (member, i): in, the step's reference point; out, the new mean
-  bool update_reference;                // false: leave the reference point (the first step of a fused pair)
-  BankVector<MemSpace> mean;            // (member, i)
-  BankSymmetric<MemSpace> covariance;   // (member, packed)
+  BankVector<MemSpace> reference;      // (member, i): in, the step's reference point; out, the new mean
+  bool update_reference;               // false: leave the reference point (the first step of a fused pair)
+  BankVector<MemSpace> mean;           // (member, i)
+  BankSymmetric<MemSpace> covariance;  // (member, packed)
   BankScalar<double, MemSpace> ess, log_normalizer;
   BankScalar<int, MemSpace> resample, resample_count;
   BankScalar<Status, MemSpace> status;
-  double resample_below;                // resample when ESS < this (threshold * N)
-  Kokkos::View<int*, MemSpace> resample_list;  // if allocated: the resampled members, [0, resample_list_size())
+  double resample_below;                           // resample when ESS < this (threshold * N)
+  Kokkos::View<int*, MemSpace> resample_list;      // if allocated: the resampled members, [0, resample_list_size())
   Kokkos::View<int, MemSpace> resample_list_size;  // (in any order: each member's resampling is its own)
 
   KOKKOS_INLINE_FUNCTION void operator()(const int member) const {

@@ -3,8 +3,8 @@
 // below the threshold this step. The member's log-weights become weights exp(l - log_normalizer) in place,
 // then cumulative weights (resample_member), then the particles are gathered by ancestor into a scratch
 // bank and copied back, and the weights reset to equal.
-#include "kernels/bank.hpp"
 #include "core/math.hpp"
+#include "kernels/bank.hpp"
 #include "kernels/particle_filter/resampling.hpp"
 #include "kernels/particle_filter/tuning.hpp"
 
@@ -19,8 +19,8 @@ struct ParticleResampleStep {
   using MemSpace = typename ExecSpace::memory_space;
   using Team = typename Kokkos::TeamPolicy<ExecSpace>::member_type;
   using Scratch = Kokkos::View<double*, typename ExecSpace::scratch_memory_space, Kokkos::MemoryUnmanaged>;
-  ParticleBank<MemSpace> x, x_scratch;              // (particle, member, i)
-  ResamplingWorkspace<MemSpace> ws;                 // ws.cumulative is the log-weight bank
+  ParticleBank<MemSpace> x, x_scratch;  // (particle, member, i)
+  ResamplingWorkspace<MemSpace> ws;     // ws.cumulative is the log-weight bank
   BankScalar<double, MemSpace> log_normalizer;
   BankScalar<int, MemSpace> resample;
   int num_particles;

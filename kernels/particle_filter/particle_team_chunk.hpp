@@ -34,7 +34,9 @@ KOKKOS_INLINE_FUNCTION ParticleChunk particle_chunk(const Team& team, int chunk,
 
 /// Slot k of the batch that starts at pair `base` holds particle 2 (base + (k / 2) threads) + k % 2: a thread's
 /// pairs are strided by the team size, so a warp's loads are contiguous.
-KOKKOS_INLINE_FUNCTION int batch_particle(int base, int k, int threads) { return 2 * (base + (k / 2) * threads) + k % 2; }
+KOKKOS_INLINE_FUNCTION int batch_particle(int base, int k, int threads) {
+  return 2 * (base + (k / 2) * threads) + k % 2;
+}
 
 /// Loads the batch's particles (and log-weights, unless initializing) from one member's columns: xm[j + i * stride]
 /// and lwm[j]. Slots past `end` are left as they are.

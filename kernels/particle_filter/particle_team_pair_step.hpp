@@ -18,7 +18,7 @@ struct ParticleTeamPairStep {
   using Team = typename Kokkos::TeamPolicy<ExecSpace>::member_type;
   using Scratch = Kokkos::View<double*, typename ExecSpace::scratch_memory_space, Kokkos::MemoryUnmanaged>;
   static constexpr int n = Model::state_dim, p = Model::obs_dim;
-  ParticleStepData<Model, MemSpace> d;  // step k: its inputs, increments and partials
+  ParticleStepData<Model, MemSpace> d;       // step k: its inputs, increments and partials
   ParticleSecondStep<Model, MemSpace> next;  // step k + 1: its outputs, increments and partials
 
   static std::size_t scratch_bytes(int team_size) { return team_sum_scratch_bytes<n>(team_size); }
@@ -62,8 +62,7 @@ struct ParticleTeamPairStep {
 
   /// As ParticleTeamStep::step_particles, for both steps: a batch is loaded once, stepped twice, stored once.
   KOKKOS_INLINE_FUNCTION void step_particles(int member, const ParticleChunk& c, const Vec<n>& ref,
-                                             const Vec<p>* vinv_dy, const double* shift,
-                                             WeightedMoments<n>* w) const {
+                                             const Vec<p>* vinv_dy, const double* shift, WeightedMoments<n>* w) const {
     constexpr int B = 2 * device_pairs_per_batch;
     constexpr int K = particle_draw_dim<Model, false>;
     const double log_normalizer = d.log_normalizer(member);

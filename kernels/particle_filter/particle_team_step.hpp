@@ -69,8 +69,8 @@ struct ParticleTeamStep {
       for (int k = 0; k < B; ++k) {
         const int j = batch_particle(base, k, c.threads);
         if (j >= c.end) continue;
-        const double l = update_particle<Initialize>(d, d.t, d.observation_precision, z[k], u[k], lw[k],
-                                                     log_normalizer, vinv_dy, x[k]);
+        const double l = update_particle<Initialize>(d, d.t, d.observation_precision, z[k], u[k], lw[k], log_normalizer,
+                                                     vinv_dy, x[k]);
         KUSHNER_DEVICE_UNROLL
         for (int i = 0; i < n; ++i) xm[j + i * stride] = x[k][i];
         lwm[j] = l;

@@ -28,21 +28,21 @@ template <class Model, class MemSpace>
 struct ParticleStepData {
   static constexpr int n = Model::state_dim, p = Model::obs_dim, q = Model::noise_dim;
   Model model;
-  ParticleBank<MemSpace> x;                                            // (particle, member, i)
-  Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> log_weight;     // (particle, member)
-  BankScalar<double, MemSpace> log_normalizer;                         // log sum_j exp(log_weight_j)
-  BankVector<MemSpace> reference;                                      // (member, i): previous posterior mean
-  BankVector<MemSpace> dy;                                             // (member, j): this step's increments
+  ParticleBank<MemSpace> x;                                         // (particle, member, i)
+  Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> log_weight;  // (particle, member)
+  BankScalar<double, MemSpace> log_normalizer;                      // log sum_j exp(log_weight_j)
+  BankVector<MemSpace> reference;                                   // (member, i): previous posterior mean
+  BankVector<MemSpace> dy;                                          // (member, j): this step's increments
   BankScalar<Status, MemSpace> status;
-  Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace> partials;      // (block, member, k)
-  Mat<p, p> observation_precision;  // (R R^T)^{-1} at t
+  Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace> partials;  // (block, member, k)
+  Mat<p, p> observation_precision;                                 // (R R^T)^{-1} at t
   Vec<n> initial_mean;
-  Mat<n, n> initial_root;           // any square root of the initial covariance
+  Mat<n, n> initial_root;  // any square root of the initial covariance
   double t = 0.0, dt = 0.0;
-  double sqrt_dt = 0.0;             // computed once: nvcc re-evaluated sqrt(dt) for every particle
+  double sqrt_dt = 0.0;  // computed once: nvcc re-evaluated sqrt(dt) for every particle
   std::uint32_t seed = 0, step = 0;
   int num_particles = 0, block_size = 0;
-  bool initialize = false;          // sample the initial law instead of propagating; no observation
+  bool initialize = false;  // sample the initial law instead of propagating; no observation
 };
 
 /// The second step of a fused pair (particle_team_pair_step.hpp): step + 1, over [t, t + dt]. The pair reads the
@@ -81,8 +81,7 @@ KOKKOS_INLINE_FUNCTION std::uint32_t particle_draw_step(const ParticleStepData<M
 template <class Model, bool Initialize>
 KOKKOS_INLINE_FUNCTION void draw_particle_pair(const RngKey& key, int member, int pair, std::uint32_t step,
                                                Vec<particle_draw_dim<Model, Initialize>>& z0,
-                                               Vec<particle_draw_dim<Model, Initialize>>& z1, double& u0,
-                                               double& u1) {
+                                               Vec<particle_draw_dim<Model, Initialize>>& z1, double& u0, double& u1) {
   constexpr int K = particle_draw_dim<Model, Initialize>;
   KUSHNER_DEVICE_UNROLL
   for (int i = 0; i < K; ++i) {

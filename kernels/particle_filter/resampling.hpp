@@ -49,8 +49,10 @@ KOKKOS_INLINE_FUNCTION int upper_bound_particle(const View& cumulative, int memb
   while (lo < hi) {
     const int mid = lo + (hi - lo) / 2;
     const double c = cumulative(mid, member);
-    if (inside ? c > target : c >= total) hi = mid;
-    else lo = mid + 1;
+    if (inside ? c > target : c >= total)
+      hi = mid;
+    else
+      lo = mid + 1;
   }
   return lo < n ? lo : n - 1;
 }
@@ -107,8 +109,8 @@ KOKKOS_INLINE_FUNCTION void resample_member(const Team& team, const ResamplingWo
       // residual_total is N - sum floor(N w_j) > 0 up to rounding; if rounding left a slot with no residual
       // weight, it repeats a deterministic copy (a particle of positive weight).
       a(s, member) = residual_total > 0.0
-                         ? detail::upper_bound_particle(c, member, n,
-                                                        detail::resampling_uniform(seed, member, s, step) * residual_total)
+                         ? detail::upper_bound_particle(
+                               c, member, n, detail::resampling_uniform(seed, member, s, step) * residual_total)
                          : a((s - deterministic) % deterministic, member);
     });
     team.team_barrier();
@@ -181,9 +183,9 @@ void resample_members(const ExecSpace& space, const ResamplingWorkspace<MemSpace
   KUSHNER_REQUIRE(n > 0 && ws.ancestors.extent_int(0) == n && ws.ancestors.extent_int(1) == members,
                   "ancestors have shape (" << ws.ancestors.extent(0) << ", " << ws.ancestors.extent(1) << "), weights ("
                                            << n << ", " << members << ")");
-  KUSHNER_REQUIRE(scheme != ResamplingScheme::residual ||
-                      (ws.copies.extent_int(0) == n && ws.copies.extent_int(1) == members),
-                  "residual resampling needs a copies workspace of the weights' shape");
+  KUSHNER_REQUIRE(
+      scheme != ResamplingScheme::residual || (ws.copies.extent_int(0) == n && ws.copies.extent_int(1) == members),
+      "residual resampling needs a copies workspace of the weights' shape");
   Kokkos::TeamPolicy<ExecSpace> policy(space, members, team_size > 0 ? team_size : resampling_team_size<ExecSpace>());
   policy.set_scratch_size(0, Kokkos::PerTeam(sizeof(double) * scan_num_blocks(n)));
   Kokkos::parallel_for("kushner::resample_members", policy, ResampleMembers<ExecSpace>{ws, n, scheme, seed, step});

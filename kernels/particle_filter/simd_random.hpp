@@ -5,8 +5,8 @@
 // (tests/test_particle_random.cpp); only the host particle kernel uses it, the GPU keeps Random123's version,
 // which uses the hardware's 32-bit multiply-high.
 #include "core/math.hpp"
-#include "kernels/rng.hpp"
 #include "core/small_matrix.hpp"
+#include "kernels/rng.hpp"
 
 #include <cstdint>
 #include <cstring>

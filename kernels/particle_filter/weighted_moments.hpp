@@ -4,8 +4,8 @@
 // for softmax"). Two sets merge exactly; merging block partials in a fixed order gives the same bits on any
 // number of threads. Positions are kept relative to a reference point (the previous posterior mean), so the
 // covariance does not lose digits when the mean is large compared to the spread.
-#include "kernels/bank.hpp"
 #include "core/math.hpp"
+#include "kernels/bank.hpp"
 
 #include <Kokkos_Core.hpp>
 
@@ -16,15 +16,15 @@ KOKKOS_INLINE_FUNCTION constexpr double positive_infinity() { return Kokkos::Exp
 
 template <int N>
 struct WeightedMoments {
-  static constexpr int packed = packed_size(N);       // entries of a packed N x N symmetric matrix
-  static constexpr int size = 3 + N + packed;         // doubles in a stored partial
+  static constexpr int packed = packed_size(N);  // entries of a packed N x N symmetric matrix
+  static constexpr int size = 3 + N + packed;    // doubles in a stored partial
 
   double max_log_weight;  // m: the largest log-weight of the set, or any shift near it (the GPU team kernel
                           // uses one per member and step); -inf for an empty set (or one whose weights are all zero)
   double sum_weight;      // sum e^{l - m}
   double sum_weight_sq;   // sum e^{2 (l - m)}
   Vec<N> sum_dx;          // sum e^{l - m} (x - ref)
-  Vec<packed> sum_dxdx;  // sum e^{l - m} (x - ref)(x - ref)^T, packed upper triangle
+  Vec<packed> sum_dxdx;   // sum e^{l - m} (x - ref)(x - ref)^T, packed upper triangle
 
   KOKKOS_INLINE_FUNCTION static WeightedMoments empty() {
     WeightedMoments w;

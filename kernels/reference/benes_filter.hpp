@@ -13,11 +13,11 @@
 // and variance are c + s tanh c and s + s^2 sech^2 c; x_0 has posterior ∝ N(z; M_z, S_zz) cosh(c(z)) /
 // cosh(z), integrated by Gauss-Hermite quadrature. tests/test_particle_filter_references.cpp checks it against
 // the particle filter.
-#include "kernels/bank.hpp"
 #include "core/errors.hpp"
-#include "kernels/for_each_member.hpp"
 #include "core/math.hpp"
 #include "core/status.hpp"
+#include "kernels/bank.hpp"
+#include "kernels/for_each_member.hpp"
 #include "models/benes_model.hpp"
 
 #include <Kokkos_Core.hpp>
@@ -51,14 +51,14 @@ inline HermiteRule probabilists_hermite_rule() {
 
 template <class MemSpace>
 struct BenesFilterStep {
-  BankVector<MemSpace> augmented_mean;      // (member, 2): (x_K, x_0)
-  BankSymmetric<MemSpace> augmented_cov;    // (member, 3): S_xx, S_xz, S_zz
-  BankVector<MemSpace> dy, mean;            // mean (member, 0)
-  BankSymmetric<MemSpace> variance;         // (member, 0)
+  BankVector<MemSpace> augmented_mean;    // (member, 2): (x_K, x_0)
+  BankSymmetric<MemSpace> augmented_cov;  // (member, 3): S_xx, S_xz, S_zz
+  BankVector<MemSpace> dy, mean;          // mean (member, 0)
+  BankSymmetric<MemSpace> variance;       // (member, 0)
   BankScalar<Status, MemSpace> status;
   HermiteRule rule;
   double r, dt;
-  bool update;                              // false: moments of the current state only
+  bool update;  // false: moments of the current state only
 
   KOKKOS_INLINE_FUNCTION void operator()(const int member) const {
     if (status(member) != Status::ok) return;
@@ -119,10 +119,14 @@ class BenesFilter {
   using MemSpace = typename ExecSpace::memory_space;
 
   BenesFilter(const ExecSpace& space, const BenesModel& model, int num_members, bool truth_law = false)
-      : space_(space), r_(model.r), rule_(probabilists_hermite_rule()),
+      : space_(space),
+        r_(model.r),
+        rule_(probabilists_hermite_rule()),
         augmented_mean_("kushner::benes_augmented_mean", num_members, 2),
-        augmented_cov_("kushner::benes_augmented_cov", num_members, 3), mean_("kushner::benes_mean", num_members, 1),
-        variance_("kushner::benes_variance", num_members, 1), status_("kushner::benes_status", num_members) {
+        augmented_cov_("kushner::benes_augmented_cov", num_members, 3),
+        mean_("kushner::benes_mean", num_members, 1),
+        variance_("kushner::benes_variance", num_members, 1),
+        status_("kushner::benes_status", num_members) {
     const double m0 = truth_law ? model.x0_mean[0] : model.prior_mean[0];
     const double v0 = truth_law ? model.x0_cov(0, 0) : model.prior_cov(0, 0);
     KUSHNER_INPUT_REQUIRE(v0 > 0.0, "benes: the exact filter needs a positive initial variance (got " << v0 << ")");

@@ -15,13 +15,13 @@
 // resolved while its width is about a grid spacing or more (aliasing error ~ exp(-2 pi^2 sigma^2 / h^2)):
 // min_resolution() reports the smallest sigma / h met. Axis-aligned noise only (G G^T diagonal).
 // One member per work item, sequential over the grid: a reference, not a fast path.
-#include "kernels/bank.hpp"
+#include "core/eigen_helpers.hpp"
 #include "core/errors.hpp"
-#include "kernels/for_each_member.hpp"
 #include "core/linear_algebra.hpp"
 #include "core/math.hpp"
 #include "core/status.hpp"
-#include "core/eigen_helpers.hpp"
+#include "kernels/bank.hpp"
+#include "kernels/for_each_member.hpp"
 
 #include <Kokkos_Core.hpp>
 
@@ -92,10 +92,10 @@ struct GridFilterStep {
   static constexpr int D = Model::state_dim, p = Model::obs_dim;
   Model model;
   Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> mass, next;  // (cell, member); cell = a + n b
-  BankVector<MemSpace> center, spacing;                            // (member, d)
+  BankVector<MemSpace> center, spacing;                             // (member, d)
   BankVector<MemSpace> dy, mean;
   BankSymmetric<MemSpace> covariance;
-  BankScalar<double, MemSpace> resolution;                         // smallest sigma / h so far
+  BankScalar<double, MemSpace> resolution;  // smallest sigma / h so far
   BankScalar<Status, MemSpace> status;
   Mat<p, p> observation_precision;
   int n;
@@ -229,7 +229,8 @@ class GridFilter {
     const Mat<D, D> q = g * transpose(g);
     for (int i = 0; i < D; ++i)
       for (int j = 0; j < D; ++j)
-        KUSHNER_INPUT_REQUIRE(i == j || q(i, j) == 0.0, Model::name << ": the grid filter needs axis-aligned noise (G G^T diagonal)");
+        KUSHNER_INPUT_REQUIRE(i == j || q(i, j) == 0.0,
+                              Model::name << ": the grid filter needs axis-aligned noise (G G^T diagonal)");
     const int cells = D == 1 ? n_ : n_ * n_;
     mass_ = decltype(mass_)("kushner::grid_mass", cells, num_members);
     next_ = decltype(next_)("kushner::grid_next", cells, num_members);

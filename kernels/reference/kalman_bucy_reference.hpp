@@ -9,11 +9,11 @@
 // Its posterior is exactly the particle filter's target for any dt, so the two differ by Monte Carlo error
 // only; as dt -> 0 it converges to the continuous Kalman-Bucy filter with error O(dt). One member per
 // work item; the filter bank (KB there) has its own continuous-time implementation.
-#include "kernels/bank.hpp"
 #include "core/errors.hpp"
-#include "kernels/for_each_member.hpp"
 #include "core/linear_algebra.hpp"
 #include "core/status.hpp"
+#include "kernels/bank.hpp"
+#include "kernels/for_each_member.hpp"
 #include "models/linear_model.hpp"
 
 #include <Kokkos_Core.hpp>
@@ -66,7 +66,9 @@ class KalmanBucyReference {
 
   /// Starts every member at N(prior_mean, prior_cov) (or the truths' law when `truth_law`).
   KalmanBucyReference(const ExecSpace& space, const LinearModel<N>& model, int num_members, bool truth_law = false)
-      : space_(space), model_(model), mean_("kushner::kb_reference_mean", num_members, N),
+      : space_(space),
+        model_(model),
+        mean_("kushner::kb_reference_mean", num_members, N),
         covariance_("kushner::kb_reference_covariance", num_members, packed_size(N)),
         status_("kushner::kb_reference_status", num_members) {
     auto m = Kokkos::create_mirror_view(mean_);

@@ -2,10 +2,10 @@
 // (one line naming the file and the key), the model's derivatives and forms against finite differences,
 // cubature and drift() itself, the run-time filter refusals, and, on the example files, the same numbers as
 // the built-in cubic oscillator and linear models: bit for bit wherever the arithmetic is the same.
-#include "engine/filter_bank.hpp"
 #include "drivers/filter_selection.hpp"
-#include "kernels/filters/gaussian_expectations.hpp"
 #include "drivers/model_file.hpp"
+#include "engine/filter_bank.hpp"
+#include "kernels/filters/gaussian_expectations.hpp"
 #include "models/registry.hpp"
 
 #include <gtest/gtest.h>

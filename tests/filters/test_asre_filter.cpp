@@ -66,7 +66,8 @@ TEST(AsreFilter, StopsAtTheFirstIterateWithinTheTolerance) {
   EXPECT_EQ(iterations(sine, "max_iterations"), 30) << "the declared default";
   EXPECT_EQ(sine.scores[0].diverged, 0);
 
-  const FilterReport linear = run_filters(Space(), LinearModel<2>{}, LinearModel<2>{}, 500, 5, grid, {"ASRE"}, settings);
+  const FilterReport linear =
+      run_filters(Space(), LinearModel<2>{}, LinearModel<2>{}, 500, 5, grid, {"ASRE"}, settings);
   EXPECT_EQ(iterations(linear, "min"), 1);
   EXPECT_EQ(iterations(linear, "max"), 1);
 
