@@ -7,6 +7,7 @@
 #include "drivers/fields_json.hpp"
 #include "drivers/filter_command.hpp"
 #include "drivers/filter_selection.hpp"
+#include "drivers/memory_check.hpp"
 #include "drivers/output_directory.hpp"
 #include "drivers/plots.hpp"
 #include "drivers/progress.hpp"
@@ -18,6 +19,7 @@
 
 #include <algorithm>
 #include <functional>
+#include <sstream>
 #include <string>
 #include <type_traits>
 
@@ -65,6 +67,31 @@ inline nlohmann::json filter_summary(const FilterReport& report) {
   return filters;
 }
 
+/// What the run's banks allocate (the grid filter's and the recorder's smaller arrays aside).
+struct RunMemory {
+  double bank_bytes_per_member = 0.0, particle_bytes_per_particle = 0.0, total_bytes = 0.0;
+};
+template <class Model>
+RunMemory run_memory(const CompareOptions& options, const std::vector<std::string>& filters,
+                     const ParticleSettings& particle) {
+  using Bank = FilterBank<Kokkos::DefaultHostExecutionSpace, Model>;
+  using Particles = ParticleFilterBank<Kokkos::DefaultHostExecutionSpace, Model>;
+  RunMemory memory;
+  memory.bank_bytes_per_member = Bank::bytes_per_member(static_cast<long>(filters.size()));
+  memory.total_bytes = static_cast<double>(options.run.members) * memory.bank_bytes_per_member;
+  if (std::find(filters.begin(), filters.end(), particle_filter_name) != filters.end()) {
+    memory.particle_bytes_per_particle = Particles::bytes_per_particle(particle.options);
+    memory.total_bytes += Particles::bytes_needed(options.run.members, particle.particles, particle.options);
+  }
+  return memory;
+}
+
+inline nlohmann::json memory_json(const RunMemory& memory) {
+  return {{"bank_bytes_per_member", memory.bank_bytes_per_member},
+          {"particle_bytes_per_particle", memory.particle_bytes_per_particle},
+          {"total_bytes", memory.total_bytes}};
+}
+
 }  // namespace detail
 
 template <class Model>
@@ -79,7 +106,16 @@ std::vector<std::string> check_compare_options(const Model& model, const Compare
         std::find(filters.begin(), filters.end(), exact_filter_name) != filters.end())
       check_covariance("filter EXACT (grid filter): prior_cov", model.prior_cov, /*allow_singular=*/false);
   }
-  particle_settings(options);
+  const ParticleSettings particle = particle_settings(options);
+  const detail::RunMemory memory = detail::run_memory<Model>(options, filters, particle);
+  std::ostringstream sizes, breakdown;
+  sizes << "--members " << options.run.members;
+  breakdown << "filter bank " << format_bytes(memory.bank_bytes_per_member) << " per member";
+  if (memory.particle_bytes_per_particle > 0.0) {
+    sizes << ", --particles " << particle.particles;
+    breakdown << ", particle filter " << format_bytes(memory.particle_bytes_per_particle) << " per particle";
+  }
+  require_memory_fits(memory.total_bytes, sizes.str(), breakdown.str(), selected_backend());
   for (long m : options.trajectory_members)
     KUSHNER_INPUT_REQUIRE(m >= 0 && m < options.run.members,
                           "--trajectory-members: member " << m << " is not in 0 .. " << options.run.members - 1);
@@ -144,6 +180,7 @@ nlohmann::json run_compare_with_truth(const TruthModel& truth_model, const Model
     summary["filters"] = detail::filter_summary(report);
     summary["filter_order"] = report.filters;
     summary["truths_escaped"] = report.truths_escaped;
+    summary["memory"] = detail::memory_json(detail::run_memory<Model>(options, filters, particle));
     if (report.has_reference) {
       summary["reference"] = fields_json(report.estimators.at(report.reference));
       summary["reference"]["name"] = report.reference;

@@ -1,6 +1,7 @@
 #include "engine/backend.hpp"
 
 #include <cstdlib>
+#include <fstream>
 #include <sstream>
 
 namespace kushner {
@@ -44,6 +45,24 @@ BackendDescription describe_backend(const std::string& name) {
 #endif
   if (name == "serial") d.threads = 1;
   return d;
+}
+
+std::optional<double> available_memory_bytes(const std::string& name) {
+#if defined(KOKKOS_ENABLE_CUDA)
+  if (name == "cuda") {
+    std::size_t free_bytes = 0, total_bytes = 0;
+    if (cudaMemGetInfo(&free_bytes, &total_bytes) != cudaSuccess) return std::nullopt;
+    return static_cast<double>(free_bytes);
+  }
+#endif
+  (void)name;
+  std::ifstream meminfo("/proc/meminfo");
+  std::string key;
+  double kib = 0.0;
+  std::string unit;
+  while (meminfo >> key >> kib >> unit)
+    if (key == "MemAvailable:") return kib * 1024.0;
+  return std::nullopt;
 }
 
 KokkosSession::KokkosSession() {

@@ -6,6 +6,7 @@
 
 #include <Kokkos_Core.hpp>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,10 @@ struct BackendDescription {
   std::string device;  // GPU name; empty on the host
 };
 BackendDescription describe_backend(const std::string& name);
+
+/// Bytes of memory the backend `name` can still allocate: free device memory for a GPU, MemAvailable of
+/// /proc/meminfo on the host; nullopt where unknown. For the GPU it needs Kokkos initialized.
+std::optional<double> available_memory_bytes(const std::string& name);
 
 /// Calls f(space) with an instance of the execution space called `name`.
 template <class F>

@@ -76,6 +76,15 @@ class FilterBank {
   /// The bank creates the others with Filter::create.
   using PreparedFilters = typename K::Prepared;
 
+  /// Bytes the bank allocates per member for `filters` filters: the truth and its observation increments, and
+  /// per filter its estimate, covariance, status, scores and snapshot (plus the per-member scores at the end).
+  static double bytes_per_member(long filters) {
+    const double per_filter =
+        sizeof(double) * (n + packed_size(n) + num_score_columns + num_snapshot_columns) + sizeof(Status);
+    return sizeof(double) * (n + p + num_member_score_columns) + sizeof(Status) +
+           static_cast<double>(filters) * per_filter;
+  }
+
   /// `filters`: names of filters the model supports (supported_filters, engine/filter_catalog.hpp), in report
   /// order; `options`: their settings (declared defaults where absent). The truths follow truth_model, the
   /// filters filter_model (the same in most runs; tests set them apart to show that a test can fail, and

@@ -144,6 +144,25 @@ class ParticleFilterBank {
     run_step_kernels(step_data(k * dt, dt, static_cast<std::uint32_t>(k), dy));
   }
 
+  /// Bytes the bank allocates for `members` members of `particles` particles: per particle its state and the
+  /// resampling scratch copy, its log-weight and ancestor index (and offspring count for residual resampling);
+  /// per member the block partials (at the smallest block, the host's), the scan's block sums and the
+  /// posterior. step_pair's second bank is not counted (the command line does not use it).
+  static double bytes_needed(long members, long particles, const ParticleFilterOptions& options) {
+    return static_cast<double>(members) *
+           (bytes_per_particle(options) * static_cast<double>(particles) + bytes_per_member(particles));
+  }
+  static double bytes_per_particle(const ParticleFilterOptions& options) {
+    return 2.0 * sizeof(double) * state_dim + sizeof(double) + sizeof(int) +
+           (options.scheme == ResamplingScheme::residual ? sizeof(int) : 0);
+  }
+  static double bytes_per_member(long particles) {
+    const double blocks = static_cast<double>((particles + host_particle_block - 1) / host_particle_block);
+    return sizeof(double) * (blocks * WeightedMoments<state_dim>::size + scan_num_blocks(static_cast<int>(particles)) +
+                             2.0 + 2.0 * state_dim + packed_size(state_dim)) +
+           3.0 * sizeof(int) + sizeof(Status);
+  }
+
   /// Steps k and k + 1 (increments dy, then dy_next): the same results as step(k) then step(k + 1), apart
   /// from the last bits of the sums. With the team kernel and systematic resampling (the GPU's default) the
   /// particles go through memory once for both steps: ParticleTeamPairStep reads the bank and writes a

@@ -173,6 +173,12 @@ def write_report(directory, summary, figures, no_figures=None):
              f"- seed {summary['seed']}, kushner {summary['version']} (git {summary.get('git', '?')}), "
              f"backend {backend.get('name', '?')} ({where}), Kokkos {backend.get('kokkos', '?')}",
              f"- members {summary['members']}, T = {summary['T']}, dt = {summary['dt']}"]
+    memory = summary.get("memory")
+    if memory:
+        pf = memory["particle_bytes_per_particle"]
+        lines.append(f"- memory: {memory['total_bytes'] / 2**20:.4g} MiB for the banks "
+                     f"({memory['bank_bytes_per_member']:.0f} B per member"
+                     + (f", {pf:.0f} B per particle of the particle filter)" if pf else ")"))
     if "file" in summary["model"]:
         lines.append(f"- model file: `{summary['model']['file']}` (coefficients in summary.json)")
     truth = summary.get("truth")

@@ -33,6 +33,9 @@ expect_refused "bad.toml" simulate --config "$work/bad.toml" --out "$fresh"
 printf 'members = 10\nnot_an_option = 3\n' >"$work/extra.toml"
 expect_refused "not_an_option" simulate --config "$work/extra.toml" --out "$fresh"
 expect_refused "missing.toml" simulate --config "$work/missing.toml" --out "$fresh"
+# 1e11 particles: refused before any allocation, with the size needed (this machine has far less than 2.5 TiB).
+expect_refused "--members 100000, --particles 1000000: the run needs 2.55 TiB (filter bank" \
+  compare --members 100000 --particles 1000000 --filters EKF,PF --out "$fresh"
 [ ! -e "$fresh" ] || fail "a refused run created $fresh"
 
 touch "$work/a-file"

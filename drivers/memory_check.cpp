@@ -1,0 +1,28 @@
+#include "drivers/memory_check.hpp"
+
+#include "core/errors.hpp"
+#include "engine/backend.hpp"
+
+#include <cstdio>
+#include <optional>
+
+namespace kushner {
+
+std::string format_bytes(double bytes) {
+  static const char* const units[] = {"B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"};
+  int unit = 0;
+  while (bytes >= 1024.0 && unit < 6) bytes /= 1024.0, ++unit;
+  char text[32];
+  std::snprintf(text, sizeof text, unit == 0 ? "%.0f %s" : "%.3g %s", bytes, units[unit]);
+  return text;
+}
+
+void require_memory_fits(double bytes, const std::string& sizes, const std::string& breakdown,
+                         const std::string& backend) {
+  const std::optional<double> available = available_memory_bytes(backend);
+  KUSHNER_INPUT_REQUIRE(!available || bytes <= *available, sizes << ": the run needs " << format_bytes(bytes) << " ("
+                                                                 << breakdown << "), but " << backend << " has "
+                                                                 << format_bytes(*available) << " available");
+}
+
+}  // namespace kushner
