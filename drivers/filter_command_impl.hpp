@@ -149,17 +149,19 @@ nlohmann::json run_compare_with_truth(const TruthModel& truth_model, const Model
       summary["reference"]["name"] = report.reference;
     }
     std::vector<std::string> files = {"summary.json", "timeseries.csv"};
-    out.write("timeseries.csv", detail::filter_timeseries_csv(report, context));
+    std::vector<std::pair<std::string, std::string>> contents = {
+        {"timeseries.csv", detail::filter_timeseries_csv(report, context)}};
     if (!options.trajectory_members.empty()) {
-      out.write("trajectories.csv", csv_comment(context) + recorder.trajectories_csv());
+      contents.emplace_back("trajectories.csv", csv_comment(context) + recorder.trajectories_csv());
       files.push_back("trajectories.csv");
     }
     if (!recorder.density_csv().empty()) {
-      out.write("density.csv", csv_comment(context) + recorder.density_csv());
+      contents.emplace_back("density.csv", csv_comment(context) + recorder.density_csv());
       files.push_back("density.csv");
     }
     summary["files"] = files;
-    out.write("summary.json", summary.dump(2) + "\n");
+    contents.emplace_back("summary.json", summary.dump(2) + "\n");
+    out.write_all(contents);  // all or none: a full disk leaves an earlier run's files as they were
   });
   if (options.plots) add_plots(out, summary);  // the plots read summary.json; it then records what they wrote
   return summary;
