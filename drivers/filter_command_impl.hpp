@@ -17,7 +17,9 @@
 #include "models/parameters.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <functional>
+#include <limits>
 #include <string>
 #include <type_traits>
 
@@ -79,7 +81,15 @@ std::vector<std::string> check_compare_options(const Model& model, const Compare
         std::find(filters.begin(), filters.end(), exact_filter_name) != filters.end())
       check_covariance("filter EXACT (grid filter): prior_cov", model.prior_cov, /*allow_singular=*/false);
   }
-  particle_settings(options);
+  const ParticleSettings particle = particle_settings(options);
+  if (std::find(filters.begin(), filters.end(), particle_filter_name) != filters.end()) {
+    // The particle kernels index (particle block, member) and their teams with int.
+    const long long items = static_cast<long long>(options.run.members) * particle.particles;
+    KUSHNER_INPUT_REQUIRE(items <= std::numeric_limits<std::int32_t>::max(),
+                          "--particles: --members x --particles must be at most "
+                              << std::numeric_limits<std::int32_t>::max() << ", the particle filter's index range (got "
+                              << options.run.members << " x " << particle.particles << " = " << items << ")");
+  }
   for (long m : options.trajectory_members)
     KUSHNER_INPUT_REQUIRE(m >= 0 && m < options.run.members,
                           "--trajectory-members: member " << m << " is not in 0 .. " << options.run.members - 1);
