@@ -18,7 +18,9 @@
 #include "models/parameters.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <functional>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <type_traits>
@@ -107,6 +109,14 @@ std::vector<std::string> check_compare_options(const Model& model, const Compare
       check_covariance("filter EXACT (grid filter): prior_cov", model.prior_cov, /*allow_singular=*/false);
   }
   const ParticleSettings particle = particle_settings(options);
+  if (std::find(filters.begin(), filters.end(), particle_filter_name) != filters.end()) {
+    // The particle kernels index (particle block, member) and their teams with int.
+    const long long items = static_cast<long long>(options.run.members) * particle.particles;
+    KUSHNER_INPUT_REQUIRE(items <= std::numeric_limits<std::int32_t>::max(),
+                          "--particles: --members x --particles must be at most "
+                              << std::numeric_limits<std::int32_t>::max() << ", the particle filter's index range (got "
+                              << options.run.members << " x " << particle.particles << " = " << items << ")");
+  }
   const detail::RunMemory memory = detail::run_memory<Model>(options, filters, particle);
   std::ostringstream sizes, breakdown;
   sizes << "--members " << options.run.members;
@@ -186,17 +196,19 @@ nlohmann::json run_compare_with_truth(const TruthModel& truth_model, const Model
       summary["reference"]["name"] = report.reference;
     }
     std::vector<std::string> files = {"summary.json", "timeseries.csv"};
-    out.write("timeseries.csv", detail::filter_timeseries_csv(report, context));
+    std::vector<std::pair<std::string, std::string>> contents = {
+        {"timeseries.csv", detail::filter_timeseries_csv(report, context)}};
     if (!options.trajectory_members.empty()) {
-      out.write("trajectories.csv", csv_comment(context) + recorder.trajectories_csv());
+      contents.emplace_back("trajectories.csv", csv_comment(context) + recorder.trajectories_csv());
       files.push_back("trajectories.csv");
     }
     if (!recorder.density_csv().empty()) {
-      out.write("density.csv", csv_comment(context) + recorder.density_csv());
+      contents.emplace_back("density.csv", csv_comment(context) + recorder.density_csv());
       files.push_back("density.csv");
     }
     summary["files"] = files;
-    out.write("summary.json", summary.dump(2) + "\n");
+    contents.emplace_back("summary.json", summary.dump(2) + "\n");
+    out.write_all(contents);  // all or none: a full disk leaves an earlier run's files as they were
   });
   if (options.plots) add_plots(out, summary);  // the plots read summary.json; it then records what they wrote
   return summary;

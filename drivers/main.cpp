@@ -9,6 +9,8 @@
 #include <algorithm>
 #include <iostream>
 #include <memory>
+#include <new>
+#include <string>
 
 namespace kushner {
 namespace {
@@ -117,6 +119,27 @@ int run(int argc, char** argv) {
   return 0;
 }
 
+/// `text` as one line: its first line, trailing blanks dropped (Kokkos' messages add lines such as
+/// "Traceback functionality not available").
+std::string first_line(const std::string& text) {
+  std::string line = text.substr(0, text.find('\n'));
+  while (!line.empty() && (line.back() == ' ' || line.back() == '\r')) line.pop_back();
+  return line;
+}
+
+/// Kokkos' allocation failure ("Kokkos failed to allocate memory for label "L".  Allocation using MemorySpace
+/// named "S" failed ...:  Allocation of size 74.51 G failed, ...") as "L needs 74.51 G (S)".
+std::string allocation_failure(const std::string& message) {
+  auto between = [&message](const std::string& before, const std::string& after) -> std::string {
+    const std::size_t begin = message.find(before);
+    if (begin == std::string::npos) return "?";
+    const std::size_t end = message.find(after, begin + before.size());
+    return end == std::string::npos ? "?" : message.substr(begin + before.size(), end - begin - before.size());
+  };
+  return between("label \"", "\"") + " needs " + between("Allocation of size ", " failed") + " (memory space " +
+         between("MemorySpace named \"", "\"") + ")";
+}
+
 }  // namespace
 }  // namespace kushner
 
@@ -129,8 +152,18 @@ int main(int argc, char** argv) {
   } catch (const kushner::InputError& e) {
     std::cerr << "kushner: error: " << e.what() << "\n";
     return 2;
+  } catch (const std::bad_alloc& e) {
+    std::cerr << "kushner: error: not enough memory (" << kushner::first_line(e.what())
+              << "); reduce --members or --particles\n";
+    return 2;
   } catch (const std::exception& e) {
-    std::cerr << "kushner: internal error: " << e.what() << "\n";
+    const std::string message = kushner::first_line(e.what());
+    if (message.rfind("Kokkos failed to allocate memory", 0) == 0) {  // Kokkos rethrows bad_alloc as runtime_error
+      std::cerr << "kushner: error: not enough memory: " << kushner::allocation_failure(message)
+                << "; reduce --members or --particles\n";
+      return 2;
+    }
+    std::cerr << "kushner: internal error: " << message << "\n";
     return 1;
   }
 }

@@ -9,7 +9,8 @@
 
 namespace kushner {
 
-OutputDirectory::OutputDirectory(const std::filesystem::path& path, const std::string& option) : path_(path) {
+OutputDirectory::OutputDirectory(const std::filesystem::path& path, const std::string& option)
+    : path_(path), option_(option) {
   KUSHNER_INPUT_REQUIRE(!path.empty(), option << ": empty path");
   std::error_code ec;
   if (std::filesystem::exists(path, ec)) {
@@ -29,20 +30,37 @@ OutputDirectory::OutputDirectory(const std::filesystem::path& path, const std::s
   std::filesystem::remove(probe, ec);
 }
 
-void OutputDirectory::write(const std::string& name, const std::string& content) const {
-  const auto final_path = path_ / name;
-  const auto tmp_path = path_ / (name + ".tmp");
-  {
+void OutputDirectory::write(const std::string& name, const std::string& content) const { write_all({{name, content}}); }
+
+void OutputDirectory::write_all(const std::vector<std::pair<std::string, std::string>>& files) const {
+  std::vector<std::filesystem::path> written;  // the .tmp files of this call
+  auto remove_written = [&written] {
+    std::error_code ignored;
+    for (const auto& tmp : written) std::filesystem::remove(tmp, ignored);
+  };
+  for (const auto& [name, content] : files) {
+    const auto tmp_path = path_ / (name + ".tmp");
     std::ofstream out(tmp_path, std::ios::binary);
     out << content;
     out.close();
     if (!out) {
-      std::error_code ec;
-      std::filesystem::remove(tmp_path, ec);
-      throw std::runtime_error("cannot write '" + tmp_path.string() + "': " + std::strerror(errno));
+      const int error = errno;  // ENOSPC from the write or the close: the reason to report
+      written.push_back(tmp_path);
+      remove_written();
+      KUSHNER_INPUT_REQUIRE(false, option_ << ": cannot write '" << (path_ / name).string()
+                                           << "': " << std::strerror(error) << " (files already there are unchanged)");
+    }
+    written.push_back(tmp_path);
+  }
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    std::error_code ec;
+    std::filesystem::rename(written[i], path_ / files[i].first, ec);
+    if (ec) {
+      remove_written();
+      KUSHNER_INPUT_REQUIRE(false, option_ << ": cannot rename '" << written[i].string() << "' to '" << files[i].first
+                                           << "': " << ec.message());
     }
   }
-  std::filesystem::rename(tmp_path, final_path);
 }
 
 }  // namespace kushner

@@ -3,6 +3,8 @@
 // rename, so a failed or interrupted run never truncates results a previous run wrote.
 #include <filesystem>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace kushner {
 
@@ -12,13 +14,20 @@ class OutputDirectory {
   /// `option` (e.g. "--out") otherwise.
   OutputDirectory(const std::filesystem::path& path, const std::string& option);
 
-  /// Writes `content` to path/name atomically (write name.tmp, then rename).
+  /// Writes `content` to path/name atomically (write name.tmp, then rename). InputError naming the option and
+  /// the reason (disk full, ...) when it cannot, with name.tmp removed and path/name as it was.
   void write(const std::string& name, const std::string& content) const;
+
+  /// Writes every (name, content) as name.tmp first and renames them only once all are written: a write that
+  /// fails (disk full) removes this call's .tmp files and leaves the directory as it was, never a mix of this
+  /// run's files and an earlier run's.
+  void write_all(const std::vector<std::pair<std::string, std::string>>& files) const;
 
   const std::filesystem::path& path() const { return path_; }
 
  private:
   std::filesystem::path path_;
+  std::string option_;
 };
 
 }  // namespace kushner

@@ -22,7 +22,10 @@ void add_run_options(CLI::App& app, RunOptions& o) {
   app.add_option("--dt", o.dt, "time step")->capture_default_str();
   app.add_option("--seed", o.seed, "random seed, 0 .. 4294967295")->capture_default_str();
   app.add_option("--out", o.out, "output directory (created if missing)")->capture_default_str();
-  app.add_option("--output-points", o.output_points, "number of time points in timeseries.csv")->capture_default_str();
+  app.add_option("--output-points", o.output_points,
+                 "number of time points in timeseries.csv (at most T/dt + 1; the default is capped there)")
+      ->capture_default_str()
+      ->each([&o](const std::string&) { o.output_points_given = true; });
   app.add_flag("--quiet", o.quiet, "no progress bar");
   app.add_option("--config", o.config, "read options from a TOML/INI file (keys: the long option names)");
 }
@@ -47,6 +50,10 @@ void validate_run_options(const RunOptions& o) {
                         "--dt: too small for --T (" << ratio << " steps; at most 4e9)");
   KUSHNER_INPUT_REQUIRE(problem != TimeGridProblem::not_whole_steps,
                         "--T: must be a whole number of --dt steps (T/dt = " << ratio << ")");
+  const long time_points = std::lround(ratio) + 1;  // 0, dt, ..., T
+  KUSHNER_INPUT_REQUIRE(!o.output_points_given || o.output_points <= time_points,
+                        "--output-points: must be at most T/dt + 1 = "
+                            << time_points << ", the time points 0, dt, ..., T (got " << o.output_points << ")");
 }
 
 }  // namespace kushner

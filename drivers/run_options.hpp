@@ -21,6 +21,7 @@ struct RunOptions {
   long long seed = 1;
   std::string out = "kushner-out";
   int output_points = 200;
+  bool output_points_given = false;  // --output-points was given (the default is capped at the steps quietly)
   bool quiet = false;
   std::string config;  // --config FILE, already expanded into the fields above by main()
 };

@@ -48,8 +48,8 @@ int run_simulate(const RunOptions& options, const RunContext& context) {
       summary["var_final"] = series.moments.back().variance;
       summary["diverged"] = series.moments.back().non_finite;  // paths that escaped: left out of the moments
       summary["files"] = {"summary.json", "timeseries.csv"};
-      out.write("timeseries.csv", timeseries_csv<Model>(series, context));
-      out.write("summary.json", summary.dump(2) + "\n");
+      out.write_all(
+          {{"timeseries.csv", timeseries_csv<Model>(series, context)}, {"summary.json", summary.dump(2) + "\n"}});
     });
   });
   return 0;

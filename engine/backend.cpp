@@ -4,7 +4,30 @@
 #include <fstream>
 #include <sstream>
 
+#if defined(KOKKOS_ENABLE_CUDA)
+#include <cuda_runtime_api.h>
+#endif
+
 namespace kushner {
+
+namespace {
+
+/// Kokkos::initialize sets up every backend compiled in, CUDA's included, so a CUDA build cannot start without a
+/// usable GPU, not even on a host backend: say so in one line instead of Kokkos' "cudaGetDeviceCount ...
+/// insufficient driver" internal error.
+void require_usable_gpu() {
+#if defined(KOKKOS_ENABLE_CUDA)
+  int count = 0;
+  const cudaError_t error = cudaGetDeviceCount(&count);
+  if (error != cudaSuccess || count == 0)
+    throw InputError(std::string("no usable GPU (cudaGetDeviceCount: ") +
+                     (error != cudaSuccess ? cudaGetErrorString(error) : "no device") +
+                     "); a CUDA build needs one whatever KUSHNER_BACKEND says: on this machine use a build made "
+                     "with -DKUSHNER_ENABLE_CUDA=OFF");
+#endif
+}
+
+}  // namespace
 
 std::vector<std::string> available_backends() {
   std::vector<std::string> names;
@@ -21,6 +44,7 @@ std::vector<std::string> available_backends() {
 }
 
 std::string selected_backend() {
+  require_usable_gpu();
   const auto names = available_backends();
   const char* env = std::getenv("KUSHNER_BACKEND");
   if (env == nullptr || *env == '\0') return names.front();

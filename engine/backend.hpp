@@ -16,6 +16,7 @@ namespace kushner {
 std::vector<std::string> available_backends();
 
 /// KUSHNER_BACKEND if set (checked against available_backends(): InputError otherwise), else the default.
+/// InputError in a CUDA build where no GPU is usable (Kokkos could not start, whatever the backend).
 std::string selected_backend();
 
 /// What a run records about where it ran. Needs Kokkos initialized.

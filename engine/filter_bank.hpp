@@ -247,7 +247,8 @@ class FilterBank {
       BankVector<MemSpace> per_member("kushner::member_scores", members_, num_member_score_columns);
       parallel_for_members("kushner::member_scores", space_, members_,
                            MemberScores<MemSpace>{slot.score, slot.status, truth_status_, per_member,
-                                                  static_cast<double>(points), scored_against_reference(name)});
+                                                  static_cast<double>(points), scored_against_reference(name),
+                                                  reference_ ? reference_->status() : BankScalar<Status, MemSpace>()});
       s.rmse_truth = root_mean(per_member, member_mean_squared_error);
       s.nees = mean(per_member, member_mean_nees);
       s.rmse_ref = root_mean(per_member, member_mean_squared_reference_error);
@@ -305,15 +306,19 @@ class FilterBank {
     e.slot.m = e.estimator->mean();
     e.slot.P = e.estimator->covariance();
     e.slot.status = e.estimator->status();
-    const BankVector<MemSpace> reference =
-        scored_against_reference(e.name) ? reference_->mean() : BankVector<MemSpace>();
-    parallel_for_members("kushner::estimator_score", space_, members_,
-                         EstimatorScore<n, MemSpace>{e.slot, truths_.state(), reference, truth_status_, record});
+    const bool against_reference = scored_against_reference(e.name);
+    const BankVector<MemSpace> reference = against_reference ? reference_->mean() : BankVector<MemSpace>();
+    const BankScalar<Status, MemSpace> reference_status =
+        against_reference ? reference_->status() : BankScalar<Status, MemSpace>();
+    parallel_for_members(
+        "kushner::estimator_score", space_, members_,
+        EstimatorScore<n, MemSpace>{e.slot, truths_.state(), reference, reference_status, truth_status_, record});
   }
 
   void score_reference(bool record) {
-    parallel_for_members("kushner::filter_bank_reference_score", space_, members_,
-                         typename K::Reference{reference_->mean(), truth_status_, slots_, record});
+    parallel_for_members(
+        "kushner::filter_bank_reference_score", space_, members_,
+        typename K::Reference{reference_->mean(), reference_->status(), truth_status_, slots_, record});
   }
 
   template <class View>

@@ -58,16 +58,18 @@ struct FilterBankInitialScore {
   }
 };
 
-/// After a reference (e.g. a particle filter) has taken the same step: |m - m_ref|^2 for every filter.
+/// After a reference (e.g. a particle filter) has taken the same step: |m - m_ref|^2 for every filter, on the
+/// members whose truth and reference are both still ok (a diverged reference's frozen mean is no reference).
 template <class Model, class MemSpace, class ReferenceView, class... Filters>
 struct FilterBankReferenceScore {
   ReferenceView reference;
+  BankScalar<Status, MemSpace> reference_status;
   BankScalar<Status, MemSpace> truth_status;
   FilterSlots<MemSpace, Filters...> slots;
   bool record;
 
   KOKKOS_INLINE_FUNCTION void operator()(const int member) const {
-    const bool scored = truth_status(member) == Status::ok;
+    const bool scored = truth_status(member) == Status::ok && reference_status(member) == Status::ok;
     (score_reference<Model::state_dim>(static_cast<const FilterSlot<Filters, MemSpace>&>(slots), member, reference,
                                        scored, record),
      ...);
@@ -84,6 +86,7 @@ template <int N, class MemSpace>
 struct EstimatorScore {
   FilterSlot<ExternalEstimator, MemSpace> slot;
   BankVector<MemSpace> truth, reference;
+  BankScalar<Status, MemSpace> reference_status;  // the reference's (empty with `reference`)
   BankScalar<Status, MemSpace> truth_status;
   bool record;
 
@@ -96,7 +99,8 @@ struct EstimatorScore {
     Mat<N, N> L;
     const Definiteness definiteness = semidefinite_cholesky(P, L, covariance_tolerance);
     score_member(slot, member, load<N>(truth, member), load<N>(slot.m, member), L, definiteness, record);
-    if (reference.extent(0) > 0) score_reference<N>(slot, member, reference, true, record);
+    if (reference.extent(0) > 0)
+      score_reference<N>(slot, member, reference, reference_status(member) == Status::ok, record);
   }
 };
 

@@ -26,6 +26,8 @@ struct MemberScores {
   BankVector<MemSpace> out;  // (member, MemberScoreColumn)
   double points;             // time points accumulated
   bool has_reference;
+  BankScalar<Status, MemSpace> reference_status;  // with has_reference: a member whose reference diverged has no
+                                                  // rmse_ref (its sum stopped growing when the reference froze)
 
   KOKKOS_INLINE_FUNCTION void operator()(const int member) const {
     const bool scored = status(member) == Status::ok && truth_status(member) == Status::ok;
@@ -33,8 +35,9 @@ struct MemberScores {
     out(member, member_mean_squared_error) = scored ? score(member, squared_error_sum) / points : nan;
     out(member, member_mean_nees) =
         scored && score(member, nees_points) > 0 ? score(member, nees_sum) / score(member, nees_points) : nan;
-    out(member, member_mean_squared_reference_error) =
-        scored && has_reference ? score(member, reference_squared_error_sum) / points : nan;
+    out(member, member_mean_squared_reference_error) = scored && has_reference && reference_status(member) == Status::ok
+                                                           ? score(member, reference_squared_error_sum) / points
+                                                           : nan;
   }
 };
 

@@ -33,9 +33,33 @@ expect_refused "bad.toml" simulate --config "$work/bad.toml" --out "$fresh"
 printf 'members = 10\nnot_an_option = 3\n' >"$work/extra.toml"
 expect_refused "not_an_option" simulate --config "$work/extra.toml" --out "$fresh"
 expect_refused "missing.toml" simulate --config "$work/missing.toml" --out "$fresh"
-# 1e11 particles: refused before any allocation, with the size needed (this machine has far less than 2.5 TiB).
-expect_refused "--members 100000, --particles 1000000: the run needs 2.55 TiB (filter bank" \
-  compare --members 100000 --particles 1000000 --filters EKF,PF --out "$fresh"
+# NaN or Inf in any parameter or option.
+expect_refused "--set q: 'nan' is not finite" simulate --set q=nan --out "$fresh"
+expect_refused "--set x0_mean: 'inf' is not finite" filter --set x0_mean=inf --out "$fresh"
+expect_refused "--set x0_cov: '-inf' is not finite" simulate --set x0_cov=-inf --out "$fresh"
+expect_refused "--dt: must be positive (got nan)" simulate --dt nan --out "$fresh"
+expect_refused "--T: must be positive (got inf)" simulate --T inf --out "$fresh"
+expect_refused "--ess-threshold: must be in [0, 1] (got nan)" filter --ess-threshold nan --out "$fresh"
+# Sizes whose product overflows the index type (int): members, members x particles, steps.
+expect_refused "--members: at most 2147483647 (got 4000000000)" simulate --members 4000000000 --out "$fresh"
+expect_refused "--particles: --members x --particles must be at most 2147483647, the particle filter's index range (got 100000 x 30000 = 3000000000)" \
+  filter --filters EKF,PF --members 100000 --particles 30000 --out "$fresh"
+expect_refused "--dt: too small for --T (1e+24 steps; at most 4e9)" simulate --T 1e12 --dt 1e-12 --out "$fresh"
+# More output points than time points; a --trajectory-members index out of range.
+expect_refused "--output-points: must be at most T/dt + 1 = 11, the time points 0, dt, ..., T (got 100)" \
+  simulate --T 0.1 --dt 0.01 --output-points 100 --out "$fresh"
+printf 'T = 0.1\ndt = 0.01\noutput-points = 12\n' >"$work/points.toml"
+expect_refused "--output-points: must be at most T/dt + 1 = 11" compare --config "$work/points.toml" --out "$fresh"
+expect_refused "--trajectory-members: member 7 is not in 0 .. 4" compare --members 5 --trajectory-members 0,7 --out "$fresh"
+expect_refused "--trajectory-members: member -1 is not in 0 .. 4" compare --members 5 --trajectory-members -1 --out "$fresh"
+# Banks that cannot fit: refused before any allocation, with the bytes they need (2e9 particles of a 3-D model,
+# 60 B each; not checked on a machine with more than 100 GiB available).
+if [ "$(awk '/^MemAvailable:/ {print $2}' /proc/meminfo)" -lt $((100 * 1024 * 1024)) ]; then
+  expect_refused "--members 2000, --particles 1000000: the run needs 112 GiB (filter bank" \
+    compare --model linear --set dim=3 --members 2000 --particles 1000000 --filters EKF,PF --out "$fresh"
+else
+  echo "note: more than 100 GiB available: the memory refusal is not checked here"
+fi
 [ ! -e "$fresh" ] || fail "a refused run created $fresh"
 
 touch "$work/a-file"
@@ -46,11 +70,16 @@ if [ "$(id -u)" -ne 0 ]; then  # root writes anywhere, so the permission case on
   expect_refused "not writable" simulate --members 10 --T 0.1 --dt 0.01 --out "$work/locked"
 fi
 
+# The default --output-points (200) is capped at the time points quietly; as many as there are is fine.
+"$kushner" simulate --members 5 --T 0.1 --dt 0.01 --output-points 11 --out "$work/points" --quiet
+[ "$(grep -vc '^#' "$work/points/timeseries.csv")" -eq 12 ] || fail "--output-points 11 did not give 11 rows"
+
 # Results already written survive a refused run into the same directory.
 "$kushner" simulate --members 50 --T 0.1 --dt 0.01 --out "$work/kept" --quiet
 before=$(cat "$work/kept"/* | md5sum)
 expect_refused "--dt: must be positive" simulate --members 50 --dt -0.01 --out "$work/kept"
 expect_refused "unknown model" simulate --model nope --out "$work/kept"
+expect_refused "--output-points: must be at most" simulate --members 50 --T 0.1 --dt 0.01 --output-points 12 --out "$work/kept"
 [ "$before" = "$(cat "$work/kept"/* | md5sum)" ] || fail "a refused run changed results already written"
 [ "$(ls "$work/kept" | wc -l)" -eq 2 ] || fail "stray files in $work/kept: $(ls "$work/kept")"
 echo "all bad-input cases refused cleanly"
