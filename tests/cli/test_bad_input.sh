@@ -55,7 +55,7 @@ expect_refused "--trajectory-members: member -1 is not in 0 .. 4" compare --memb
 # Banks that cannot fit: refused before any allocation, with the bytes they need (2e9 particles of a 3-D model,
 # 60 B each; not checked on a machine with more than 100 GiB available).
 if [ "$(awk '/^MemAvailable:/ {print $2}' /proc/meminfo)" -lt $((100 * 1024 * 1024)) ]; then
-  expect_refused "--members 2000, --particles 1000000: the run needs 112 GiB (filter bank" \
+  expect_refused "--members 2000, --particles 1000000: the run needs 113 GiB (filter bank 331 B per member, particle filter 60 B per particle)" \
     compare --model linear --set dim=3 --members 2000 --particles 1000000 --filters EKF,PF --out "$fresh"
 else
   echo "note: more than 100 GiB available: the memory refusal is not checked here"
