@@ -7,7 +7,8 @@
 // Paper values (002 L1505): v = l = 1, u = 0.05, truth from phi(0) = delta(0) = 0, filters from
 // m(0) = (10, 0.1), P(0) = [[100, 10], [10, 1]] (singular: every filter here works without P^{-1}), V = I
 // (r = 1), no process noise (q = 0). The paper "realizes" the observation noises as sin t; here they are
-// Brownian. Time-varying steering inputs are not modelled: u is constant.
+// Brownian. The constant u is the open-loop steering rate; `kushner control` adds a control w to it,
+// ddelta = (u + w) dt (B = (0, 1), as in Basin's regulator and controller, 002 (14), (16)).
 #include "core/errors.hpp"
 #include "core/math.hpp"
 #include "core/small_matrix.hpp"
@@ -18,7 +19,7 @@ namespace kushner {
 
 /// What the two car models share: parameters, initial laws, noise and the observation of both angles.
 struct CarBase : InitialLaw<2> {
-  static constexpr int state_dim = 2, obs_dim = 2, noise_dim = 2, control_dim = 0;
+  static constexpr int state_dim = 2, obs_dim = 2, noise_dim = 2, control_dim = 1;
   static constexpr bool discrete_time = false;
   static constexpr bool linear_observation = true;
   using Control = Vec<control_dim>;
@@ -44,6 +45,7 @@ struct CarBase : InitialLaw<2> {
 
   void validate() const { KUSHNER_INPUT_REQUIRE(l != 0.0, "l: the wheelbase must not be 0"); }
 
+  KOKKOS_INLINE_FUNCTION Mat<2, 1> control_input(double) const { return {{{0.0}, {1.0}}}; }
   KOKKOS_INLINE_FUNCTION Mat<2, 2> diffusion(double, const Vec<2>&) const { return Mat<2, 2>::diagonal(q); }
   KOKKOS_INLINE_FUNCTION Vec<2> observation(double, const Vec<2>& x) const { return x; }
   KOKKOS_INLINE_FUNCTION Mat<2, 2> observation_jacobian(double, const Vec<2>&) const { return Mat<2, 2>::identity(); }
@@ -59,8 +61,8 @@ struct CarModel : CarBase {
   /// E|tan(delta)| is infinite for Gaussian delta (poles at +-pi/2): no quasi-linear filter exists.
   static constexpr bool drift_gaussian_integrable = false;
 
-  KOKKOS_INLINE_FUNCTION Vec<2> drift(double, const Vec<2>& x, const Control&) const {
-    return {{v / l * math::tan(x[1]), u}};
+  KOKKOS_INLINE_FUNCTION Vec<2> drift(double, const Vec<2>& x, const Control& w) const {
+    return {{v / l * math::tan(x[1]), u + w[0]}};
   }
   KOKKOS_INLINE_FUNCTION Mat<2, 2> drift_jacobian(double, const Vec<2>& x, const Control&) const {
     const double c = math::cos(x[1]);
@@ -86,9 +88,9 @@ struct CarTaylor3Model : CarBase {
   static constexpr const char* description =
       "Basin's car, degree-3 Taylor model: dphi = (v/l)(delta + delta^3/3) dt, ddelta = u dt, dz = x dt + r dv";
 
-  KOKKOS_INLINE_FUNCTION Vec<2> drift(double, const Vec<2>& x, const Control&) const {
+  KOKKOS_INLINE_FUNCTION Vec<2> drift(double, const Vec<2>& x, const Control& w) const {
     const double d = x[1];
-    return {{v / l * (d + d * d * d / 3.0), u}};
+    return {{v / l * (d + d * d * d / 3.0), u + w[0]}};
   }
   KOKKOS_INLINE_FUNCTION Mat<2, 2> drift_jacobian(double, const Vec<2>& x, const Control&) const {
     return {{{0.0, v / l * (1.0 + x[1] * x[1])}, {0.0, 0.0}}};

@@ -6,7 +6,7 @@
 // at t ~ 0.34. We read a lost decimal point: the truth starts at (1.5, 1.0) (`--set x0_mean=15,10` gives the
 // printed start). The paper gives neither q, r nor the filters' initial covariance; ours: q = r = 0.5,
 // prior N(0, I). Even so, a few percent of noisy paths escape over long horizons: such members are counted
-// as diverged, not averaged in.
+// as diverged, not averaged in. Controlled (`kushner control`): a force u on x2, B = (0, 1).
 #include "core/small_matrix.hpp"
 #include "models/drift_forms.hpp"
 #include "models/initial_law.hpp"
@@ -14,7 +14,7 @@
 namespace kushner {
 
 struct CubicOscillatorModel : InitialLaw<2> {
-  static constexpr int state_dim = 2, obs_dim = 2, noise_dim = 1, control_dim = 0;
+  static constexpr int state_dim = 2, obs_dim = 2, noise_dim = 1, control_dim = 1;
   static constexpr bool discrete_time = false;
   static constexpr bool linear_observation = true;
   static constexpr const char* name = "cubic-oscillator";
@@ -23,6 +23,7 @@ struct CubicOscillatorModel : InitialLaw<2> {
   using Control = Vec<control_dim>;
 
   double q = 0.5, r = 0.5;
+  Mat<2, 1> B{{{0.0}, {1.0}}};
 
   CubicOscillatorModel() {
     x0_mean = Vec<2>{{1.5, 1.0}};
@@ -35,12 +36,14 @@ struct CubicOscillatorModel : InitialLaw<2> {
   void parameters(Visitor&& v) {
     v("q", q, "process noise intensity (on x2)");
     v("r", r, "observation noise intensity (both components)");
+    v("B", B, "control input matrix (kushner control)");
     initial_law_parameters(v);
   }
 
-  KOKKOS_INLINE_FUNCTION Vec<2> drift(double, const Vec<2>& x, const Control&) const {
-    return {{x[1], -x[1] - x[0] + x[0] * x[0] * x[0] / 8.0}};
+  KOKKOS_INLINE_FUNCTION Vec<2> drift(double, const Vec<2>& x, const Control& u) const {
+    return Vec<2>{{x[1], -x[1] - x[0] + x[0] * x[0] * x[0] / 8.0}} + B * u;
   }
+  KOKKOS_INLINE_FUNCTION Mat<2, 1> control_input(double) const { return B; }
   KOKKOS_INLINE_FUNCTION Mat<2, 2> drift_jacobian(double, const Vec<2>& x, const Control&) const {
     return {{{0.0, 1.0}, {-1.0 + 3.0 * x[0] * x[0] / 8.0, -1.0}}};
   }

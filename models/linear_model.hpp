@@ -3,7 +3,8 @@
 //   dx = (a0 + A x) dt + b dw,   dy = (c0 + C x) dt + R dv,   w, v standard N-dimensional Brownian motions.
 // Default: a damped rotation A = -0.5 I + J (J: +1 above, -1 below the diagonal), b = 0.5 I, C = I,
 // R = 0.5 I, a0 = c0 = 0, x(0) ~ N(1, 0.1 I) for truths and prior alike. All matrices are settable.
-// The observation has the state's dimension; a partial observation is a row of C set to zero.
+// The observation has the state's dimension; a partial observation is a row of C set to zero. Controlled
+// (`kushner control`): dx = (a0 + A x + B u) dt + b dw with one input, B = (0, ..., 0, 1) by default.
 #include "core/small_matrix.hpp"
 #include "models/drift_forms.hpp"
 #include "models/initial_law.hpp"
@@ -12,7 +13,7 @@ namespace kushner {
 
 template <int N>
 struct LinearModel : InitialLaw<N> {
-  static constexpr int state_dim = N, obs_dim = N, noise_dim = N, control_dim = 0;
+  static constexpr int state_dim = N, obs_dim = N, noise_dim = N, control_dim = 1;
   static constexpr bool discrete_time = false;
   static constexpr const char* name = "linear";
   static constexpr const char* description = "linear: dx = (a0 + A x) dt + b dw, dy = (c0 + C x) dt + R dv (dim 1..3)";
@@ -24,6 +25,7 @@ struct LinearModel : InitialLaw<N> {
   Vec<N> c0 = Vec<N>::zero();
   Mat<N, N> C = Mat<N, N>::identity();
   Mat<N, N> R = Mat<N, N>::diagonal(0.5);
+  Mat<N, 1> B = default_control_input();
 
   LinearModel() { this->set_initial_law(Vec<N>::constant(1.0), Mat<N, N>::diagonal(0.1)); }
 
@@ -36,6 +38,12 @@ struct LinearModel : InitialLaw<N> {
     return a;
   }
 
+  static Mat<N, 1> default_control_input() {
+    Mat<N, 1> b = Mat<N, 1>::zero();
+    b(N - 1, 0) = 1.0;
+    return b;
+  }
+
   template <class Visitor>
   void parameters(Visitor&& v) {
     v("a0", a0, "constant drift term");
@@ -44,10 +52,12 @@ struct LinearModel : InitialLaw<N> {
     v("c0", c0, "constant observation term");
     v("C", C, "observation matrix");
     v("R", R, "observation noise intensity");
+    v("B", B, "control input matrix (kushner control)");
     this->initial_law_parameters(v);
   }
 
-  KOKKOS_INLINE_FUNCTION Vec<N> drift(double, const Vec<N>& x, const Control&) const { return a0 + A * x; }
+  KOKKOS_INLINE_FUNCTION Vec<N> drift(double, const Vec<N>& x, const Control& u) const { return a0 + A * x + B * u; }
+  KOKKOS_INLINE_FUNCTION Mat<N, 1> control_input(double) const { return B; }
   KOKKOS_INLINE_FUNCTION Mat<N, N> drift_jacobian(double, const Vec<N>&, const Control&) const { return A; }
   KOKKOS_INLINE_FUNCTION Mat<N, N> drift_hessian(double, const Vec<N>&, const Control&, int) const {
     return Mat<N, N>::zero();

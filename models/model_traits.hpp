@@ -75,6 +75,8 @@ struct ModelTraits {
   static constexpr bool quadratic_polynomial = linear || detail::has_quadratic_polynomial<Model>::value;
   static constexpr bool polynomial = power_polynomial || quadratic_polynomial;
   static constexpr bool sdc = linear || detail::has_sdc_drift<Model>::value;
+  /// dx = (f(t, x) + B(t) u) dt: the model has a control input, B = control_input(t) (`kushner control`).
+  static constexpr bool controlled = Model::control_dim > 0;
   /// E_N[f] exists for every Gaussian (false for tan: E|tan x| is infinite).
   static constexpr bool gaussian_integrable = !detail::declares_non_integrable_drift<Model>::value;
   /// E_N[f], E_N[grad f] in closed form: the model's own formulas, or exact Gaussian moments of a polynomial.

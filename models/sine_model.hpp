@@ -1,7 +1,8 @@
 #pragma once
 // Sunahara (1968) Example 1, seed 000 eqs. (6.1)-(6.3):  dx = -sin(x) dt + q dw,  dy = x dt + r dv.
 // The paper gives no noise levels or initial law (figures only); ours, stated in the README: q = 1, r = 0.5,
-// x(0) ~ N(1, 1) for the truths and the filters' prior alike.
+// x(0) ~ N(1, 1) for the truths and the filters' prior alike. Controlled (`kushner control`): a force u on x,
+// dx = (-sin(x) + B u) dt + q dw, B = 1.
 #include "core/math.hpp"
 #include "core/small_matrix.hpp"
 #include "models/drift_forms.hpp"
@@ -10,7 +11,7 @@
 namespace kushner {
 
 struct SineModel : InitialLaw<1> {
-  static constexpr int state_dim = 1, obs_dim = 1, noise_dim = 1, control_dim = 0;
+  static constexpr int state_dim = 1, obs_dim = 1, noise_dim = 1, control_dim = 1;
   static constexpr bool discrete_time = false;
   static constexpr bool linear_observation = true;
   static constexpr const char* name = "sine";
@@ -18,6 +19,7 @@ struct SineModel : InitialLaw<1> {
   using Control = Vec<control_dim>;
 
   double q = 1.0, r = 0.5;
+  Mat<1, 1> B = Mat<1, 1>::identity();
 
   SineModel() { set_initial_law(Vec<1>{{1.0}}, Mat<1, 1>{{{1.0}}}); }
 
@@ -25,10 +27,14 @@ struct SineModel : InitialLaw<1> {
   void parameters(Visitor&& v) {
     v("q", q, "process noise intensity");
     v("r", r, "observation noise intensity");
+    v("B", B, "control input matrix (kushner control)");
     initial_law_parameters(v);
   }
 
-  KOKKOS_INLINE_FUNCTION Vec<1> drift(double, const Vec<1>& x, const Control&) const { return {{-math::sin(x[0])}}; }
+  KOKKOS_INLINE_FUNCTION Vec<1> drift(double, const Vec<1>& x, const Control& u) const {
+    return {{-math::sin(x[0]) + B(0, 0) * u[0]}};
+  }
+  KOKKOS_INLINE_FUNCTION Mat<1, 1> control_input(double) const { return B; }
   KOKKOS_INLINE_FUNCTION Mat<1, 1> drift_jacobian(double, const Vec<1>& x, const Control&) const {
     return {{{-math::cos(x[0])}}};
   }
