@@ -1,6 +1,7 @@
 #pragma once
 // The subcommands of `kushner`. Each validates all its input before opening any output and throws
 // InputError for bad input; main() turns that into one line on stderr and exit code 2.
+#include "drivers/control_options.hpp"
 #include "drivers/filter_options.hpp"
 #include "drivers/reproduce/reproduce_options.hpp"
 #include "drivers/run_metadata.hpp"
@@ -21,6 +22,13 @@ int run_compare(const CompareOptions& options, const RunContext& context);
 /// `kushner reproduce NAME`: a worked example of the seeds run by the engine, with compare's artefacts and a
 /// table of the paper's numbers next to ours (reproduction.csv, reproduction.md, printed on stdout).
 int run_reproduce(const ReproduceOptions& options, const RunContext& context);
+
+/// `kushner control`: controllers LAW@ESTIMATOR in closed loop; writes summary.json, timeseries.csv, plots and
+/// report.md.
+int run_control_command(const ControlOptions& options, const RunContext& context);
+
+/// `kushner controllers`: the gain laws, estimators, aliases and the models each law can control.
+int run_controllers_list(bool json);
 
 /// `kushner filters`: every filter and the models it supports (or why not).
 int run_filters_list(bool json);

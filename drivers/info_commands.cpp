@@ -30,15 +30,6 @@ int run_models(bool json) {
   return 0;
 }
 
-/// Whether `kushner filters` lists this type: a name with several dimensions is listed at its default.
-template <class Model>
-constexpr bool listed_once() {
-  if constexpr (dimension_choice<Model>::selectable)
-    return Model::state_dim == dimension_choice<Model>::default_dim;
-  else
-    return true;
-}
-
 int run_filters_list(bool json) {
   // filter name -> (supported models, refused models with the reason), in report order
   const std::vector<std::string> names = all_filter_names();

@@ -31,6 +31,8 @@ struct Options {
   FilterOptions filter;
   CompareOptions compare = compare_defaults();
   ReproduceOptions reproduce;
+  ControlOptions control;
+  bool controllers_json = false;
   bool models_json = false;
   bool filters_json = false;
 };
@@ -52,6 +54,12 @@ std::unique_ptr<CLI::App> make_app(Options& o) {
                                              "run a worked example of the seed papers and put the "
                                              "paper's numbers next to ours"),
                         o.reproduce);
+  add_control_options(*app->add_subcommand("control",
+                                           "controllers LAW@ESTIMATOR in closed loop on the bank, scored by "
+                                           "their expected cost"),
+                      o.control);
+  app->add_subcommand("controllers", "list the control laws, estimators and aliases, and the models they control")
+      ->add_flag("--json", o.controllers_json, "as JSON");
   app->add_subcommand("models", "list the built-in models and their parameters")
       ->add_flag("--json", o.models_json, "as JSON");
   app->add_subcommand("filters", "list the filters and the models each supports")
@@ -105,6 +113,12 @@ int run(int argc, char** argv) {
     context.seed = static_cast<std::uint32_t>(o.compare.run.seed);
     context.backend = selected_backend();
     return run_compare(o.compare, context);
+  }
+  if (app->got_subcommand("controllers")) return run_controllers_list(o.controllers_json);
+  if (app->got_subcommand("control")) {
+    context.seed = static_cast<std::uint32_t>(o.control.run.seed);
+    context.backend = selected_backend();
+    return run_control_command(o.control, context);
   }
   if (app->got_subcommand("reproduce")) {
     context.backend = selected_backend();

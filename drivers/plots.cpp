@@ -31,8 +31,13 @@ std::string python_interpreter() {
 }  // namespace
 
 PlotResult write_plots_and_report(const OutputDirectory& out) {
+  return write_plots_and_report(out, "compare_plots.py", {"estimates", "errors", "rmse_ref", "density"});
+}
+
+PlotResult write_plots_and_report(const OutputDirectory& out, const std::string& script_name,
+                                  const std::vector<std::string>& figures) {
   PlotResult result;
-  const std::filesystem::path script = std::filesystem::path(KUSHNER_SOURCE_DIR) / "drivers/plots/compare_plots.py";
+  const std::filesystem::path script = std::filesystem::path(KUSHNER_SOURCE_DIR) / "drivers/plots" / script_name;
   const std::string command = shell_quote(python_interpreter()) + " " + shell_quote(script.string()) + " " +
                               shell_quote(out.path().string()) + " 2>&1";
   FILE* pipe = popen(command.c_str(), "r");
@@ -55,10 +60,9 @@ PlotResult write_plots_and_report(const OutputDirectory& out) {
     return result;
   }
   result.ok = true;
-  for (const char* name : {"estimates", "errors", "rmse_ref", "density"})
+  for (const std::string& name : figures)
     for (const char* ext : {".png", ".svg"})
-      if (std::filesystem::exists(out.path() / (std::string(name) + ext)))
-        result.files.push_back(name + std::string(ext));
+      if (std::filesystem::exists(out.path() / (name + ext))) result.files.push_back(name + ext);
   result.files.push_back("report.md");
   return result;
 }

@@ -18,4 +18,8 @@ struct PlotResult {
 /// $KUSHNER_PYTHON, else /usr/bin/python3 (Debian's, with python3-matplotlib), else python3 on PATH.
 PlotResult write_plots_and_report(const OutputDirectory& out);
 
+/// The same with another script of drivers/plots/ and the figures it may draw (NAME.png, NAME.svg).
+PlotResult write_plots_and_report(const OutputDirectory& out, const std::string& script,
+                                  const std::vector<std::string>& figures);
+
 }  // namespace kushner

@@ -50,6 +50,31 @@ struct FilterScores {
   long diverged = 0, not_positive_definite = 0, non_finite = 0;  // among members whose truth did not escape
 };
 
+/// Selects filter Filter in its slot: the filter made by its pre-pass (`ready`) or by Filter::create with
+/// `options`, its views for `members` members, every member at the model's prior. Shared by the filter bank and
+/// the closed loops of `kushner control` (engine/control/closed_loop.hpp).
+template <class Filter, class MemSpace, class Model>
+void enable_filter_slot(FilterSlot<Filter, MemSpace>& slot, const Model& model, long members,
+                        const OptionValues& options, const std::optional<Filter>& ready) {
+  constexpr int n = Model::state_dim;
+  slot.enabled = true;
+  slot.filter = ready ? *ready : Filter::create(options.with_defaults(filter_options<Filter>()), model, members);
+  slot.m = BankVector<MemSpace>(std::string("kushner::m_") + Filter::name, members, n);
+  slot.P = BankSymmetric<MemSpace>(std::string("kushner::P_") + Filter::name, members, packed_size(n));
+  slot.status = BankScalar<Status, MemSpace>(std::string("kushner::status_") + Filter::name, members);
+  slot.score = BankVector<MemSpace>(std::string("kushner::score_") + Filter::name, members, num_score_columns);
+  slot.snapshot = BankVector<MemSpace>(std::string("kushner::snapshot_") + Filter::name, members, num_snapshot_columns);
+  const auto mh = Kokkos::create_mirror_view(slot.m);
+  const auto Ph = Kokkos::create_mirror_view(slot.P);
+  for (long member = 0; member < members; ++member) {
+    for (int i = 0; i < n; ++i) mh(member, i) = model.prior_mean[i];
+    for (int i = 0; i < n; ++i)
+      for (int j = i; j < n; ++j) Ph(member, packed_index(n, i, j)) = model.prior_cov(i, j);
+  }
+  Kokkos::deep_copy(slot.m, mh);
+  Kokkos::deep_copy(slot.P, Ph);
+}
+
 /// `TruthModel`: the truths' model type, Model unless the truths follow another system of the same dimensions
 /// (kernels/filters/filter_bank_step.hpp).
 template <class ExecSpace, class Model, class TruthModel = Model>
@@ -105,17 +130,7 @@ class FilterBank {
         using Filter = decltype(slot.filter);
         if (name != Filter::name) return;
         found = true;
-        slot.enabled = true;
-        const std::optional<Filter>& ready = std::get<std::optional<Filter>>(prepared);
-        slot.filter =
-            ready ? *ready : Filter::create(options.with_defaults(filter_options<Filter>()), filter_model, members);
-        slot.m = BankVector<MemSpace>(std::string("kushner::m_") + Filter::name, members, n);
-        slot.P = BankSymmetric<MemSpace>(std::string("kushner::P_") + Filter::name, members, packed_size(n));
-        slot.status = BankScalar<Status, MemSpace>(std::string("kushner::status_") + Filter::name, members);
-        slot.score = BankVector<MemSpace>(std::string("kushner::score_") + Filter::name, members, num_score_columns);
-        slot.snapshot =
-            BankVector<MemSpace>(std::string("kushner::snapshot_") + Filter::name, members, num_snapshot_columns);
-        fill_prior(slot.m, slot.P);
+        enable_filter_slot(slot, filter_model, members, options, std::get<std::optional<Filter>>(prepared));
       });
       KUSHNER_REQUIRE(found, "filter '" << name << "' is not supported by model " << Model::name);
     }
@@ -278,18 +293,6 @@ class FilterBank {
   template <class F, class... Filters>
   void for_each_slot_impl(F& f, std::tuple<Filters...>*) const {
     (f(static_cast<const FilterSlot<Filters, MemSpace>&>(slots_)), ...);
-  }
-
-  void fill_prior(const BankVector<MemSpace>& m, const BankSymmetric<MemSpace>& P) const {
-    const auto mh = Kokkos::create_mirror_view(m);
-    const auto Ph = Kokkos::create_mirror_view(P);
-    for (long member = 0; member < members_; ++member) {
-      for (int i = 0; i < n; ++i) mh(member, i) = filter_model_.prior_mean[i];
-      for (int i = 0; i < n; ++i)
-        for (int j = i; j < n; ++j) Ph(member, packed_index(n, i, j)) = filter_model_.prior_cov(i, j);
-    }
-    Kokkos::deep_copy(m, mh);
-    Kokkos::deep_copy(P, Ph);
   }
 
   struct Estimator {

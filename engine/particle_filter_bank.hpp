@@ -137,11 +137,17 @@ class ParticleFilterBank {
     run_step_kernels(d);
   }
 
-  /// Step k: [k dt, (k + 1) dt] with the members' observation increments dy (member, j) over it.
-  void step(long k, double dt, const BankVector<MemSpace>& dy) {
+  /// Step k: [k dt, (k + 1) dt] with the members' observation increments dy (member, j) over it, and in a closed
+  /// loop the control (member, j) each member's truth was driven by over it (empty: none).
+  void step(long k, double dt, const BankVector<MemSpace>& dy, const BankVector<MemSpace>& control = {}) {
     require_increments_shape(dy);
     KUSHNER_REQUIRE(k >= 0 && k < (1L << 32), "step " << k << " outside the counter range");
-    run_step_kernels(step_data(k * dt, dt, static_cast<std::uint32_t>(k), dy));
+    KUSHNER_REQUIRE(control.extent(0) == 0 ||
+                        (control.extent_int(0) == num_members_ && control.extent_int(1) == Model::control_dim),
+                    "control bank has shape (" << control.extent(0) << ", " << control.extent(1) << ")");
+    ParticleStepData<Model, MemSpace> d = step_data(k * dt, dt, static_cast<std::uint32_t>(k), dy);
+    d.control = control;
+    run_step_kernels(d);
   }
 
   /// Bytes the bank allocates for `members` members of `particles` particles: per particle its state and the

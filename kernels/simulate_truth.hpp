@@ -53,6 +53,8 @@ void initialize_gaussian(const ExecSpace& space, const BankVector<MemSpace>& x, 
 
 /// One Euler-Maruyama step of every member over [t, t + dt]:
 ///   dy = h(t, x) dt + R dv,   x <- x + f(t, x, u) dt + G(t, x) dw,   dw, dv ~ N(0, dt I),
+/// with u = 0 (open loop) or, in a closed loop, the member's control (step_member). The draws depend on seed,
+/// member and step only, so every controller's loop sees the same noise (common random numbers).
 /// or dv = model.observation_noise_increment(t, dt) where the model's observation noise is a deterministic path.
 template <class Model, class MemSpace>
 struct EulerMaruyamaTruthStep {
@@ -61,10 +63,12 @@ struct EulerMaruyamaTruthStep {
   double t, dt;
   std::uint32_t seed, step;
 
-  KOKKOS_INLINE_FUNCTION void operator()(const int member) const {
+  KOKKOS_INLINE_FUNCTION void operator()(const int member) const { step_member(member, Model::Control::zero()); }
+
+  /// The step of one member driven by the control u over it (a closed loop's, kernels/control/).
+  KOKKOS_INLINE_FUNCTION void step_member(const int member, const typename Model::Control& u) const {
     constexpr int n = Model::state_dim, p = Model::obs_dim, q = Model::noise_dim;
     const Vec<n> xm = load<n>(x, member);
-    const typename Model::Control u = Model::Control::zero();
     const double sqrt_dt = math::sqrt(dt);
     const Vec<q> dw = normal_vector<q>(RngKey{seed, Stream::process_noise}, member, 0, step) * sqrt_dt;
     Vec<p> dv;

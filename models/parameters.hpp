@@ -29,7 +29,9 @@ std::pair<std::string, std::string> split_assignment(const std::string& assignme
 /// Applies one key=value to the field named key; `found` tells whether the model has such a field.
 class ParameterSetter {
  public:
-  ParameterSetter(std::string key, std::string text) : key_(std::move(key)), text_(std::move(text)) {}
+  /// `flag`: the option the assignment came from, for messages ("--set", "--cost").
+  ParameterSetter(std::string key, std::string text, std::string flag = "--set")
+      : key_(std::move(key)), text_(std::move(text)), flag_(std::move(flag)) {}
   bool found() const { return found_; }
 
   void operator()(const char* name, double& field, const char*) {
@@ -52,7 +54,8 @@ class ParameterSetter {
   template <int R, int C>
   void operator()(const char* name, Mat<R, C>& field, const char*) {
     if (key_ != name) return;
-    const ParameterValue v = parse(name);
+    ParameterValue v = parse(name);
+    if (C == 1 && R > 1 && v.rows == 1 && v.cols == R) std::swap(v.rows, v.cols);  // a column given as "0,1"
     expect_shape(v, R, C);
     for (int i = 0; i < R; ++i)
       for (int j = 0; j < C; ++j) field(i, j) = v.values[i * C + j];
@@ -64,16 +67,16 @@ class ParameterSetter {
     return parse_parameter_value(name, text_);
   }
   void expect_shape(const ParameterValue& v, int rows, int cols) const {
-    KUSHNER_INPUT_REQUIRE(v.rows == rows && v.cols == cols, "--set " << key_ << ": expected " << shape_name(rows, cols)
-                                                                     << ", got " << shape_name(v.rows, v.cols) << " '"
-                                                                     << text_ << "'");
+    KUSHNER_INPUT_REQUIRE(v.rows == rows && v.cols == cols,
+                          flag_ << " " << key_ << ": expected " << shape_name(rows, cols) << ", got "
+                                << shape_name(v.rows, v.cols) << " '" << text_ << "'");
   }
   static std::string shape_name(int rows, int cols) {
     if (rows == 1 && cols == 1) return "a number";
     if (rows == 1) return "a vector of " + std::to_string(cols);
     return "a " + std::to_string(rows) + "x" + std::to_string(cols) + " matrix";
   }
-  std::string key_, text_;
+  std::string key_, text_, flag_;
   bool found_ = false;
 };
 

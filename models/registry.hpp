@@ -28,6 +28,16 @@ struct dimension_choice<LinearModel<N>> {
   static constexpr int default_dim = 2;
 };
 
+/// Whether a listing of models (`kushner filters`, `kushner controllers`) shows this type: a name with several
+/// dimensions is listed at its default.
+template <class Model>
+constexpr bool listed_once() {
+  if constexpr (dimension_choice<Model>::selectable)
+    return Model::state_dim == dimension_choice<Model>::default_dim;
+  else
+    return true;
+}
+
 namespace detail {
 
 template <class Tuple, class F, std::size_t... I>

@@ -168,6 +168,13 @@ struct AsreFilter {
             {"iterations.max_iterations", static_cast<long>(summary.max_iterations)}};
   }
 
+  /// A closed loop's known input B u dt enters every iterate's mean equation alike (seed 001 Theorem 3 (ii)).
+  KOKKOS_INLINE_FUNCTION void apply_known_input(int member, const Vec<n>& shift) const {
+    const int last = iterations(member);
+    for (int it = 0; it <= last; ++it)
+      for (int i = 0; i < n; ++i) m(member, i, it) += shift[i];
+  }
+
   KOKKOS_INLINE_FUNCTION Status step(const Model& model, int member, const StepInput<p>& in, Vec<n>& m_out,
                                      Mat<n, n>& P_out) const {
     static_assert(unsupported == nullptr,

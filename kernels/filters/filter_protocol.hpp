@@ -16,6 +16,9 @@
 //   template <class RunAlone>                                 // the pre-pass itself: run_alone(filter) runs the
 //   static Filter prepare(const OptionValues&, const Model&, long members, RunAlone&&);  // truths with it alone
 //   Fields summary_fields() const;                            // what it adds to its summary.json entry
+//   KOKKOS_INLINE_FUNCTION void apply_known_input(int member, const Vec<n>& shift) const;  // a filter with means
+//                                                 // of its own besides m (ASRE's iterates) adds a closed loop's
+//                                                 // B u dt to them after its step (kernels/filters/filter_slot.hpp)
 #include "core/fields.hpp"
 #include "core/options.hpp"
 #include "models/drift_facts.hpp"
@@ -50,6 +53,13 @@ template <class Filter, class = void>
 struct has_prepass : std::false_type {};
 template <class Filter>
 struct has_prepass<Filter, std::void_t<decltype(Filter::prepass_passes)>> : std::true_type {};
+
+template <class Filter, int N, class = void>
+struct has_known_input : std::false_type {};
+template <class Filter, int N>
+struct has_known_input<
+    Filter, N, std::void_t<decltype(std::declval<const Filter&>().apply_known_input(0, std::declval<const Vec<N>&>()))>>
+    : std::true_type {};
 
 template <class Filter, class = void>
 struct has_summary_fields : std::false_type {};

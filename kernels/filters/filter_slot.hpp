@@ -4,6 +4,7 @@
 // advance() is what the bank's fused step kernel does for one member and one filter.
 #include "core/status.hpp"
 #include "kernels/bank.hpp"
+#include "kernels/filters/filter_protocol.hpp"
 #include "kernels/filters/filter_step.hpp"
 
 #include <Kokkos_Core.hpp>
@@ -66,10 +67,13 @@ KOKKOS_INLINE_FUNCTION void mark_unscored(const Slot& s, int member) {
 
 /// One step of one member for one filter: the filter's step, then the divergence checks (non-finite values;
 /// P not positive semidefinite), then the scores against the new truth x. A diverged member keeps its last
-/// good m, P and is not updated again.
+/// good m, P and is not updated again. In a closed loop, `control_shift` = B(t) u dt, the known input's part of
+/// the mean's Euler step: every filter's prediction is m + (a + B u) dt with P unchanged by a known additive
+/// input (kernels/filters/filter_step.hpp), so adding it after the filter's own step is that step exactly.
 template <class Model, class Filter, class MemSpace>
 KOKKOS_INLINE_FUNCTION void advance(const FilterSlot<Filter, MemSpace>& s, const Model& model, int member,
-                                    const StepInput<Model::obs_dim>& in, const Vec<Model::state_dim>& x, bool record) {
+                                    const StepInput<Model::obs_dim>& in, const Vec<Model::state_dim>& x, bool record,
+                                    const Vec<Model::state_dim>& control_shift = Vec<Model::state_dim>::zero()) {
   constexpr int n = Model::state_dim;
   if (!s.enabled) return;
   if (s.status(member) != Status::ok) {
@@ -79,6 +83,8 @@ KOKKOS_INLINE_FUNCTION void advance(const FilterSlot<Filter, MemSpace>& s, const
   Vec<n> m = load<n>(s.m, member);
   Mat<n, n> P = load_symmetric<n>(s.P, member);
   Status status = s.filter.step(model, member, in, m, P);
+  m += control_shift;
+  if constexpr (detail::has_known_input<Filter, n>::value) s.filter.apply_known_input(member, control_shift);
   if (status == Status::ok && !(all_finite(m) && all_finite(P))) status = Status::non_finite;
   Mat<n, n> L;
   Definiteness definiteness = Definiteness::indefinite;

@@ -62,6 +62,7 @@ KUSHNER_SAME_CODE_FOR_ALL_CALLERS void particle_block_host(const ParticleStepDat
       u[2 * k + 1] = u1;
     }
   }
+  const typename Model::Control control = particle_control(d, member);
   KUSHNER_SIMD
   for (int j = 0; j < count; ++j) {
     Vec<n> xj;
@@ -71,8 +72,8 @@ KUSHNER_SAME_CODE_FOR_ALL_CALLERS void particle_block_host(const ParticleStepDat
     KUSHNER_UNROLL_FULLY
     for (int i = 0; i < K; ++i) zj[i] = z[i][j];
     const double uj = draws_uniform<Model, Initialize> ? u[j] : 0.0;
-    const double lj =
-        update_particle<Initialize>(d, d.t, d.observation_precision, zj, uj, lw[j], log_normalizer, vinv_dy, xj);
+    const double lj = update_particle<Initialize>(d, d.t, d.observation_precision, zj, uj, lw[j], log_normalizer,
+                                                  vinv_dy, control, xj);
     KUSHNER_UNROLL_FULLY
     for (int i = 0; i < n; ++i) xs[i][j] = xj[i];
     lw[j] = lj;

@@ -58,6 +58,7 @@ struct ParticleTeamStep {
     const std::size_t stride = d.x.stride_2();  // LayoutLeft: x(j, member, i) = xm[j + i * stride]
     const RngKey key = particle_draw_key<Initialize>(d);
     const std::uint32_t step = particle_draw_step<Initialize>(d);
+    const typename Model::Control control = particle_control(d, member);
     for (int base = c.begin / 2 + c.rank; base < (c.end + 1) / 2; base += device_pairs_per_batch * c.threads) {
       Vec<n> x[B];
       double lw[B];
@@ -70,7 +71,7 @@ struct ParticleTeamStep {
         const int j = batch_particle(base, k, c.threads);
         if (j >= c.end) continue;
         const double l = update_particle<Initialize>(d, d.t, d.observation_precision, z[k], u[k], lw[k], log_normalizer,
-                                                     vinv_dy, x[k]);
+                                                     vinv_dy, control, x[k]);
         KUSHNER_DEVICE_UNROLL
         for (int i = 0; i < n; ++i) xm[j + i * stride] = x[k][i];
         lwm[j] = l;

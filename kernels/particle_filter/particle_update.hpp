@@ -34,6 +34,7 @@ struct ParticleStepData {
   BankVector<MemSpace> reference;                                   // (member, i): previous posterior mean
   BankVector<MemSpace> dy;                                          // (member, j): this step's increments
   BankScalar<Status, MemSpace> status;
+  BankVector<MemSpace> control;  // (member, j): the control over this step (closed loop); empty: none
   Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace> partials;  // (block, member, k)
   Mat<p, p> observation_precision;                                 // (R R^T)^{-1} at t
   Vec<n> initial_mean;
@@ -99,15 +100,26 @@ KOKKOS_INLINE_FUNCTION Vec<Model::obs_dim> precision_times_dy(const ParticleStep
   return d.observation_precision * load<Model::obs_dim>(d.dy, member);
 }
 
+/// The control a member's particles are driven by over this step (zero outside a closed loop).
+template <class Model, class MemSpace>
+KOKKOS_INLINE_FUNCTION typename Model::Control particle_control(const ParticleStepData<Model, MemSpace>& d,
+                                                                int member) {
+  if constexpr (Model::control_dim > 0) {
+    if (d.control.extent(0) > 0) return load<Model::control_dim>(d.control, member);
+  }
+  return Model::Control::zero();
+}
+
 /// Moves one particle (x in, x out) over [t, t + dt] with its draws (normals z, uniform u) and returns its new
 /// log-weight, normalized by the member's previous log-normalizer; -inf for a particle that left the finite
-/// numbers. `precision` is V^{-1} at t.
+/// numbers. `precision` is V^{-1} at t; `control` is the member's (particle_control).
 template <bool Initialize, class Model, class MemSpace>
 KOKKOS_INLINE_FUNCTION double update_particle(const ParticleStepData<Model, MemSpace>& d, double t,
                                               const Mat<Model::obs_dim, Model::obs_dim>& precision,
                                               const Vec<particle_draw_dim<Model, Initialize>>& z, double u,
                                               double log_weight, double log_normalizer,
-                                              const Vec<Model::obs_dim>& vinv_dy, Vec<Model::state_dim>& x) {
+                                              const Vec<Model::obs_dim>& vinv_dy,
+                                              const typename Model::Control& control, Vec<Model::state_dim>& x) {
   constexpr int n = Model::state_dim, p = Model::obs_dim;
   if constexpr (Initialize) {
     x = d.initial_mean + d.initial_root * z;
@@ -116,7 +128,6 @@ KOKKOS_INLINE_FUNCTION double update_particle(const ParticleStepData<Model, MemS
     if constexpr (has_exact_transition<Model>::value) {
       x = d.model.sample_exact_transition(t, x, d.dt, z, u);
     } else {
-      const typename Model::Control control = Model::Control::zero();
       x = x + d.model.drift(t, x, control) * d.dt + d.model.diffusion(t, x) * (z * d.sqrt_dt);
     }
     const Vec<p> h = d.model.observation(t + d.dt, x);
