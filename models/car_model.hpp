@@ -81,6 +81,9 @@ struct CarModel : CarBase {
     const double tan_over = math::fabs(d) < 1e-4 ? 1.0 + d * d / 3.0 : math::tan(d) / d;
     return {{{{0.0, v / l * tan_over}, {0.0, 0.0}}}, {{0.0, u}}};
   }
+  /// The polynomial a controller is designed on (Basin's regulator, 002 control paper (10)): the degree-3 Taylor
+  /// model of car-taylor3, since tan has no power-polynomial form (engine/control/poly3_regulator.hpp).
+  KOKKOS_INLINE_FUNCTION PowerPolynomial<2, 3> design_polynomial(double) const;
 };
 
 struct CarTaylor3Model : CarBase {
@@ -113,5 +116,13 @@ struct CarTaylor3Model : CarBase {
     return {{{{0.0, v / l * (1.0 + x[1] * x[1] / 3.0)}, {0.0, 0.0}}}, {{0.0, u}}};
   }
 };
+
+KOKKOS_INLINE_FUNCTION PowerPolynomial<2, 3> CarModel::design_polynomial(double t) const {
+  CarTaylor3Model taylor;
+  taylor.v = v;
+  taylor.l = l;
+  taylor.u = u;
+  return taylor.drift_power_polynomial(t);
+}
 
 }  // namespace kushner
