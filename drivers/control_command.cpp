@@ -12,6 +12,7 @@
 #include "drivers/run_model.hpp"
 #include "engine/backend.hpp"
 #include "engine/control/control_run.hpp"
+#include "engine/control/cost_reference.hpp"
 #include "kernels/filters/filter_list.hpp"
 #include "models/parameters.hpp"
 #include "models/registry.hpp"
@@ -164,7 +165,10 @@ MeanSe mean_se(std::size_t members, Value&& value) {
   return r;
 }
 
-nlohmann::json controllers_json(const ControlReport& report, std::string& best) {
+/// Every controller's entry of summary.json. J_gap is J - J* against the reference where there is one (its SE
+/// the controller's: J* is a number), else the paired difference to the best controller, member by member.
+nlohmann::json controllers_json(const ControlReport& report, const std::optional<CostReference>& reference,
+                                std::string& best) {
   const auto& runs = report.controllers;
   std::size_t best_index = 0;
   std::vector<MeanSe> J(runs.size());
@@ -178,7 +182,8 @@ nlohmann::json controllers_json(const ControlReport& report, std::string& best) 
   for (std::size_t c = 0; c < runs.size(); ++c) {
     const ControllerRun& run = runs[c];
     // Paired with the best controller, member by member, over the members both kept finite.
-    const MeanSe gap = mean_se(run.cost.size(), [&](std::size_t i) { return run.cost[i] - runs[best_index].cost[i]; });
+    MeanSe gap = mean_se(run.cost.size(), [&](std::size_t i) { return run.cost[i] - runs[best_index].cost[i]; });
+    if (reference) gap = MeanSe{J[c].mean - reference->J, J[c].se, J[c].count};
     const MeanSe energy = mean_se(run.control_energy.size(), [&](std::size_t i) {
       return std::isfinite(run.cost[i]) ? run.control_energy[i] : std::nan("");
     });
@@ -188,7 +193,7 @@ nlohmann::json controllers_json(const ControlReport& report, std::string& best) 
                         {"J_se", J[c].se},
                         {"J_gap", gap.mean},
                         {"J_gap_se", gap.se},
-                        {"gap_to", best},
+                        {"gap_to", reference ? "reference" : best},
                         {"members_scored", J[c].count},
                         {"control_energy", energy.mean},
                         {"control_energy_se", energy.se},
@@ -223,7 +228,12 @@ std::string control_timeseries_csv(const ControlReport& report, const RunContext
 }
 
 void print_summary(const nlohmann::json& summary, const std::string& out) {
-  std::printf("%-16s %24s %24s %12s %9s\n", "controller", "J", "J - best (paired)", "energy", "diverged");
+  const bool referenced = summary.contains("reference");
+  if (referenced)
+    std::printf("reference J* = %.6g (%s, discretization error <= %.2g)\n", summary["reference"]["J"].get<double>(),
+                summary["reference"]["kind"].get<std::string>().c_str(), summary["reference"]["error"].get<double>());
+  std::printf("%-16s %24s %24s %12s %9s\n", "controller", "J", referenced ? "J - J*" : "J - best (paired)", "energy",
+              "diverged");
   for (const auto& name : summary["controller_order"]) {
     const nlohmann::json& c = summary["controllers"][name.get<std::string>()];
     auto number = [&](const char* key) { return c[key].is_number() ? c[key].get<double>() : std::nan(""); };
@@ -243,6 +253,13 @@ void run_control_model(const Model& model, const ControlOptions& options, const 
   // Everything is checked before the output directory is opened.
   const std::vector<ControllerSpec> specs = select_controllers(options.controllers, model);
   const QuadraticCost<n, m> cost = parse_cost<Model>(options.cost);
+  if (options.reference == "direct")
+    KUSHNER_INPUT_REQUIRE(deterministic_problem(model),
+                          "--reference direct: the problem is stochastic (process noise "
+                          "or a random start); the direct method needs a deterministic one");
+  if (options.reference == "hjb")
+    KUSHNER_INPUT_REQUIRE(hjb_solvable<Model>(),
+                          "--reference hjb: model '" << Model::name << "' is not of dimension 1-2 with one control");
   const ParticleSettings particle = particle_settings(options);
   KUSHNER_INPUT_REQUIRE(
       options.trace_member >= 0 && options.trace_member < options.run.members,
@@ -279,8 +296,15 @@ void run_control_model(const Model& model, const ControlOptions& options, const 
     const ControlReport report = run_control(
         space, model, options.run.members, static_cast<std::uint32_t>(options.run.seed), grid, specs, cost, settings,
         particle, [&](long done) { progress.update(done); }, options.trace_member);
+    const std::optional<CostReference> reference = cost_reference(model, cost, grid, options.reference);
     summary = run_metadata(context);
     summary["command_kind"] = "control";
+    if (reference) {
+      summary["reference"] = fields_json(reference->fields);
+      summary["reference"]["kind"] = reference->kind;
+      summary["reference"]["J"] = reference->J;
+      summary["reference"]["error"] = reference->error;
+    }
     summary["model"] = model_summary(model);
     summary["members"] = options.run.members;
     summary["T"] = options.run.T;
@@ -289,7 +313,7 @@ void run_control_model(const Model& model, const ControlOptions& options, const 
     summary["cost"] = cost_json(cost);
     summary["cost"]["form"] = "J = (x(T)-x*)'F(x(T)-x*) + int_0^T (x-x*)'Q(x-x*) + u'Ru dt";
     std::string best;
-    summary["controllers"] = controllers_json(report, best);
+    summary["controllers"] = controllers_json(report, reference, best);
     summary["best"] = best;
     std::vector<std::string> order;
     for (const auto& spec : specs) order.push_back(spec.name);

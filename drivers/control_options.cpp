@@ -11,6 +11,11 @@ void add_control_options(CLI::App& app, ControlOptions& o) {
                  "cost weight key=value: F (terminal), Q (running state), R (control), target (x*); "
                  "J = (x(T)-x*)'F(x(T)-x*) + int (x-x*)'Q(x-x*) + u'Ru dt; default F = Q = I, R = I, x* = 0")
       ->allow_extra_args(false);
+  app.add_option("--reference", o.reference,
+                 "optimal-cost reference J*: auto (direct for a deterministic problem, else hjb for dimension 1-2), "
+                 "hjb, direct, none")
+      ->check(CLI::IsMember({"auto", "hjb", "direct", "none"}))
+      ->capture_default_str();
   app.add_option("--trace-member", o.trace_member, "member whose paths go to timeseries.csv and the plots")
       ->capture_default_str();
   app.add_flag("!--no-plots", o.plots, "write the CSV and JSON files only (no plots, no report.md)");

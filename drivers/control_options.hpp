@@ -14,7 +14,9 @@ namespace kushner {
 struct ControlOptions : FilterOptions {
   std::string controllers = "NONE@state,LQR@state,LQR@EKF,LQR@PF";
   std::vector<std::string> cost;  // "key=value": F, Q, R, target
-  long trace_member = 0;          // the member whose paths go to timeseries.csv and the plots
+  std::string reference =
+      "auto";             // the optimal-cost reference: auto, hjb, direct, none (engine/control/cost_reference.hpp)
+  long trace_member = 0;  // the member whose paths go to timeseries.csv and the plots
   bool plots = true;
 };
 

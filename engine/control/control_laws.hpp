@@ -3,10 +3,16 @@
 // the one place a law name becomes a ControlLaw (the command line lists and checks names from law_list()).
 //   NONE   no control: the plant left alone, the baseline;
 //   LQR    the affine LQR of the model linearized at the origin (engine/control/gain_laws.hpp);
-//   ASRE   Cimen & Banks' approximating sequence of Riccati equations on the nominal path (gain_laws.hpp).
+//   ASRE   Cimen & Banks' approximating sequence of Riccati equations on the nominal path (gain_laws.hpp);
+//   POLY3  Basin's polynomial regulator along its nominal path, the two-point problem solved by the sweep and by
+//          Newton (poly3_regulator.hpp);
+//   HJB    the optimal feedback of the Hamilton-Jacobi-Bellman equation by Kushner's Markov chain approximation,
+//          tabulated (hjb_markov_chain.hpp; dimension 1-2, one control); with `state` it is the reference law.
 #include "core/errors.hpp"
 #include "core/fields.hpp"
 #include "engine/control/gain_laws.hpp"
+#include "engine/control/hjb_markov_chain.hpp"
+#include "engine/control/poly3_regulator.hpp"
 #include "engine/time_grid.hpp"
 #include "kernels/control/control_law.hpp"
 #include "models/model_traits.hpp"
@@ -16,6 +22,9 @@
 
 namespace kushner {
 
+/// POLY3's Newton solve of the two-point problem runs up to this many steps (its dense Jacobian is O(steps^3)).
+constexpr long max_poly3_exact_steps = 600;
+
 struct LawInfo {
   std::string name, description;
 };
@@ -23,7 +32,30 @@ struct LawInfo {
 inline std::vector<LawInfo> law_list() {
   return {{"NONE", "no control (u = 0): the uncontrolled plant, a baseline"},
           {"LQR", "linear-quadratic regulator of the model linearized at the origin, affine in the target"},
-          {"ASRE", "Cimen-Banks approximating sequence of Riccati equations (seed 001 Th. 3), on the nominal path"}};
+          {"ASRE", "Cimen-Banks approximating sequence of Riccati equations (seed 001 Th. 3), on the nominal path"},
+          {"POLY3",
+           "Basin's polynomial regulator of degree 3 (seed 002 (16)-(17)), two-point problem by sweep and "
+           "Newton"},
+          {"HJB", "optimal feedback of the HJB equation by Kushner's Markov chain approximation (dim 1-2, tabulated)"}};
+}
+
+/// POLY3 designs on a power polynomial of degree <= 3: the model's drift, or its design_polynomial (the car's
+/// Taylor model).
+template <class Model>
+constexpr bool poly3_designable() {
+  if constexpr (!ModelTraits<Model>::controlled)
+    return false;
+  else if constexpr (detail::has_design_polynomial<Model>::value)
+    return true;
+  else
+    return ModelTraits<Model>::power_polynomial && ModelTraits<Model>::power_degree() <= 3 &&
+           !ModelTraits<Model>::runtime_checked;
+}
+
+/// HJB's chain: dimension 1 or 2, one control.
+template <class Model>
+constexpr bool hjb_solvable() {
+  return Model::state_dim <= 2 && Model::control_dim == 1;
 }
 
 /// Why `law` cannot control Model, or nullptr.
@@ -31,6 +63,8 @@ template <class Model>
 const char* law_unsupported(const std::string& law) {
   if (!ModelTraits<Model>::controlled) return "the model has no control input";
   if (law == "ASRE" && !ModelTraits<Model>::sdc) return "the model has no factorization f = A(x) x + b";
+  if (law == "POLY3" && !poly3_designable<Model>()) return "the drift is not a polynomial of degree <= 3";
+  if (law == "HJB" && !hjb_solvable<Model>()) return "the Markov chain approximation needs dimension 1-2, one control";
   return nullptr;
 }
 
@@ -72,6 +106,39 @@ MadeLaw<Model, MemSpace> make_law(const std::string& name, const Model& model,
                        {"last_change", solution.last_change}};
         return made;
       }
+    }
+  }
+  if constexpr (poly3_designable<Model>()) {
+    if (name == "POLY3") {
+      Poly3Options poly3;
+      poly3.run_exact = grid.steps <= max_poly3_exact_steps;  // Newton's dense Jacobian: O(steps^3)
+      const auto solution = poly3_regulator(model, cost, model.prior_mean, grid.steps, grid.dt, poly3);
+      KUSHNER_INPUT_REQUIRE(solution.converged(), "POLY3: the two-point boundary problem was not solved: sweep: "
+                                                      << solution.sweep.reason << "; exact: " << solution.exact.reason);
+      made.law = affine_law<n, m, MemSpace>(solution.gains);
+      made.fields = {
+          {"law", std::string("POLY3")},
+          {"reading", std::string(poly3_reading_name(poly3.reading))},
+          {"sweep.converged", static_cast<long>(solution.sweep.converged)},
+          {"sweep.iterations", static_cast<long>(solution.sweep.iterations)},
+          {"sweep.reason", solution.sweep.reason},
+          {"exact.converged", static_cast<long>(solution.exact.converged)},
+          {"exact.iterations", static_cast<long>(solution.exact.iterations)},
+          {"exact.reason", poly3.run_exact ? solution.exact.reason : std::string("not run: more than 600 steps")},
+          {"nominal_J", solution.nominal.J}};
+      return made;
+    }
+  }
+  if constexpr (hjb_solvable<Model>()) {
+    if (name == "HJB") {
+      const HjbSolution<n> solution = hjb_markov_chain(model, cost, grid.steps * grid.dt);
+      made.law = table_law<n, m, MemSpace>(solution.table, grid.dt);
+      made.fields = {{"law", std::string("HJB")},
+                     {"J_star", solution.J},
+                     {"chain_dt", solution.dt},
+                     {"u_bound", solution.u_bound},
+                     {"bound_active_fraction", solution.bound_active_fraction}};
+      return made;
     }
   }
   KUSHNER_REQUIRE(false, "make_law: unknown law " << name);
