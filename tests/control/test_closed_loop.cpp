@@ -1,6 +1,7 @@
 // The closed loop (engine/control/): LQG against its exact expected cost, ASRE@ASRE against LQG, and the
 // separation made explicit (a better estimator gives a lower cost under the same law).
 #include "engine/control/control_run.hpp"
+#include "engine/control/cost_reference.hpp"
 #include "models/model_list.hpp"
 
 #include <gtest/gtest.h>
@@ -114,6 +115,42 @@ TEST(ClosedLoop, NoControlCostsMoreThanLqrWithTheState) {
   for (int i = 0; i < 2000; ++i) diff[i] = report.controllers[0].cost[i] - report.controllers[1].cost[i];
   const MeanSe d = mean_se(diff);
   EXPECT_GT(d.mean, 5.0 * d.se) << "NONE - LQR = " << d.mean << " +- " << d.se;
+}
+
+// Certainty equivalence with the true conditional mean: under the same law, the particle filter's estimate controls
+// no worse than the EKF's (within 3 paired standard errors), and the HJB reference J* (full information) is below
+// every controller (none beats it by more than 3 standard errors plus J*'s own discretization error).
+TEST(ClosedLoop, ParticleEstimateControlsNoWorseThanEkfAndNobodyBeatsTheHjbOptimum) {
+  const Kokkos::DefaultHostExecutionSpace space;
+  SineModel model;
+  model.r = 2.0;  // a hard regime: the observation says little, the estimators differ
+  model.set_initial_law(Vec<1>{{0.0}}, Mat<1, 1>{{{4.0}}});
+  QuadraticCost<1, 1> cost;
+  cost.Q(0, 0) = 1.0;
+  cost.F(0, 0) = 1.0;
+  const TimeGrid grid = make_time_grid(2.0, 1e-2, 2);
+  ParticleSettings particle;
+  particle.particles = 512;
+  const long members = 1000;
+  const auto report = run_control(space, model, members, 9, grid,
+                                  {{"LQR@EKF", "LQR", "EKF"},
+                                   {"LQR@PF", "LQR", "PF"},
+                                   {"LQR@state", "LQR", "state"},
+                                   {"HJB@state", "HJB", "state"},
+                                   {"HJB@PF", "HJB", "PF"}},
+                                  cost, {}, particle);
+  std::vector<double> diff(members);
+  for (long i = 0; i < members; ++i) diff[i] = report.controllers[1].cost[i] - report.controllers[0].cost[i];
+  const MeanSe d = mean_se(diff);
+  EXPECT_LT(d.mean, 3.0 * d.se) << "J(LQR@PF) - J(LQR@EKF) = " << d.mean << " +- " << d.se;
+  const auto reference = cost_reference(model, cost, grid, "hjb");
+  ASSERT_TRUE(reference.has_value());
+  for (const auto& run : report.controllers) {
+    const MeanSe J = mean_se(run.cost);
+    EXPECT_GT(J.mean, reference->J - 3.0 * J.se - reference->error)
+        << run.spec.name << ": J " << J.mean << " +- " << J.se << ", J* " << reference->J << " (error "
+        << reference->error << ")";
+  }
 }
 
 }  // namespace
