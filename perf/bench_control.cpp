@@ -15,8 +15,6 @@
 namespace kushner {
 namespace {
 
-using Space = Kokkos::DefaultExecutionSpace;
-using MemSpace = Space::memory_space;
 constexpr long horizon_steps = 300;  // T = 0.3, as in Basin's car examples
 constexpr double dt = 1e-3;
 
@@ -40,7 +38,9 @@ QuadraticCost<2, 1> bench_cost() {
   return cost;
 }
 
+template <class Space>
 void BM_ClosedLoopCar4(benchmark::State& state) {
+  using MemSpace = typename Space::memory_space;
   const long members = state.range(0);
   const Space space;
   const CarModel car = bench_car();
@@ -75,6 +75,7 @@ void BM_ClosedLoopCar4(benchmark::State& state) {
     if (loop.truths_escaped() > 0) state.SkipWithError("a truth escaped");
 }
 
+template <class Space>
 void BM_CarTruthStepAlone(benchmark::State& state) {
   const long members = state.range(0);
   const Space space;
@@ -91,8 +92,31 @@ void BM_CarTruthStepAlone(benchmark::State& state) {
   state.counters["member_steps_per_s"] = C(static_cast<double>(members), C::kIsIterationInvariantRate);
 }
 
-BENCHMARK(BM_ClosedLoopCar4)->ArgName("members")->Arg(10000)->Arg(100000)->Arg(1000000)->UseManualTime();
-BENCHMARK(BM_CarTruthStepAlone)->ArgName("members")->Arg(10000)->Arg(100000)->Arg(1000000)->UseManualTime();
+// The default execution space (the GPU in a CUDA build) and, where it differs, the host's (OpenMP: set
+// OMP_NUM_THREADS=2 for the two-thread figure).
+using Device = Kokkos::DefaultExecutionSpace;
+using Host = Kokkos::DefaultHostExecutionSpace;
+BENCHMARK_TEMPLATE(BM_ClosedLoopCar4, Device)
+    ->ArgName("members")
+    ->Arg(10000)
+    ->Arg(100000)
+    ->Arg(1000000)
+    ->UseManualTime();
+BENCHMARK_TEMPLATE(BM_CarTruthStepAlone, Device)
+    ->ArgName("members")
+    ->Arg(10000)
+    ->Arg(100000)
+    ->Arg(1000000)
+    ->UseManualTime();
+#if defined(KOKKOS_ENABLE_CUDA)
+BENCHMARK_TEMPLATE(BM_ClosedLoopCar4, Host)->ArgName("members")->Arg(10000)->Arg(100000)->Arg(1000000)->UseManualTime();
+BENCHMARK_TEMPLATE(BM_CarTruthStepAlone, Host)
+    ->ArgName("members")
+    ->Arg(10000)
+    ->Arg(100000)
+    ->Arg(1000000)
+    ->UseManualTime();
+#endif
 
 }  // namespace
 }  // namespace kushner

@@ -9,6 +9,7 @@
 #include "engine/control/control_laws.hpp"
 #include "engine/progress_callback.hpp"
 #include "engine/time_grid.hpp"
+#include "kernels/host_copy.hpp"
 
 #include <Kokkos_Core.hpp>
 
@@ -60,12 +61,14 @@ long control_progress_steps(const std::vector<ControllerSpec>& specs, const Time
 
 namespace detail {
 
+/// One member's row of a (member, column) view, on the host (host_copy: the row is strided).
 template <class ExecSpace, class View>
 std::vector<double> host_row(const ExecSpace& space, const View& v, long member) {
   space.fence();
-  const auto row = Kokkos::subview(v, member, Kokkos::ALL);
-  const auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), row);
-  return std::vector<double>(h.data(), h.data() + h.extent(0));
+  const auto h = host_copy(Kokkos::subview(v, member, Kokkos::ALL));
+  std::vector<double> row(h.extent(0));
+  for (std::size_t i = 0; i < row.size(); ++i) row[i] = h(i);
+  return row;
 }
 
 }  // namespace detail
