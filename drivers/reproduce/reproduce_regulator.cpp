@@ -237,6 +237,9 @@ ExampleResult reproduce_regulator(const RegulatorCase& c, const ReproduceSetting
       "direct): its summary.json, timeseries.csv, figures and report.md. The printed readings and the optimum's path "
       "are computed by the same engine (engine/control/poly3_regulator.hpp, direct_optimum.hpp).\n" +
       findings +
+      "- Tolerance: J is dominated by (1 - phi(T))^2, so 1% of J (about 0.007) is wider than the spread of every law "
+      "here, the uncontrolled plant included; J rows agree easily and phi(T), delta(T) (and q(0)) are the numbers "
+      "that tell the readings apart.\n"
       "- Verdicts: a row reproduces within half a unit of the printed digit or 1% (below). The direct optimum is a "
       "floor: no law, printed or ours, can have a smaller J on (18) from this start under the stated cost, so a "
       "printed J below it is impossible, not merely unreproduced.\n";
