@@ -9,6 +9,7 @@
 #include "models/car_model.hpp"
 #include "models/linear_model.hpp"
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -61,6 +62,50 @@ Outcome outcome_of(const Solution& s, const NominalPath<2, 1>& applied) {
   o.q[1] = s.S[0](0, 1);
   o.q[2] = s.S[0](1, 1);
   return o;
+}
+
+/// The e-notes' printed q(0) = (1.32, 16, 1640) taken at its word: (11) integrated forwards from it together with
+/// the original system (18) under u = q12 phi + q22 delta (RK4, `substeps` per step: q22' ~ -q22^2 is stiff at
+/// first), and J = (phi(T) - 1)^2 + int u^2. Where does Basin's printed start lead?
+struct ForwardEq11 {
+  bool finite = false;
+  double phi = 0, delta = 0, J = 0, q[3] = {0, 0, 0};
+};
+ForwardEq11 forward_eq11(double vl, double T, long steps, int substeps) {
+  using State = std::array<double, 6>;  // phi, delta, q11, q12, q22, int u^2
+  auto rate = [vl](const State& y) {
+    const double phi = y[0], delta = y[1], q11 = y[2], q12 = y[3], q22 = y[4];
+    const double u = q12 * phi + q22 * delta;
+    return State{vl * std::tan(delta),
+                 u,
+                 -q12 * q12,
+                 -3.0 * vl * q11 * q11 - q12 * q22 - vl * q11 - 3.0 * vl * phi * phi * q11,
+                 -2.0 * vl * q12 - 6.0 * vl * q12 * q22 - 6.0 * vl * delta * delta * q12 - q22 * q22,
+                 u * u};
+  };
+  State y{0.1, 0.1, 1.32, 16.0, 1640.0, 0.0};
+  const double h = T / (static_cast<double>(steps) * substeps);
+  auto axpy = [](const State& a, double s, const State& b) {
+    State r;
+    for (int i = 0; i < 6; ++i) r[i] = a[i] + s * b[i];
+    return r;
+  };
+  ForwardEq11 out;
+  for (long k = 0; k < steps * substeps; ++k) {
+    const State k1 = rate(y), k2 = rate(axpy(y, h / 2, k1)), k3 = rate(axpy(y, h / 2, k2)), k4 = rate(axpy(y, h, k3));
+    for (int i = 0; i < 6; ++i) y[i] += h / 6 * (k1[i] + 2 * k2[i] + 2 * k3[i] + k4[i]);
+    bool finite = true;
+    for (double v : y) finite = finite && std::isfinite(v) && std::fabs(v) < 1e12;
+    if (!finite) return out;
+  }
+  out.finite = true;
+  out.phi = y[0];
+  out.delta = y[1];
+  out.q[0] = y[2];
+  out.q[1] = y[3];
+  out.q[2] = y[4];
+  out.J = (y[0] - 1.0) * (y[0] - 1.0) + y[5];
+  return out;
 }
 
 ExampleResult reproduce_regulator(const RegulatorCase& c, const ReproduceSettings& settings, const RunContext& context,
@@ -197,6 +242,27 @@ ExampleResult reproduce_regulator(const RegulatorCase& c, const ReproduceSetting
                                          number(optimum.J) + " (Basin's units " + number(optimum.J / 2) + ")");
   }
   result.table.add("optimum/J_half", optimum.J / 2, 0.0, "the direct optimum in Basin's units (with the 1/2)");
+  if (c.enotes) {
+    const ForwardEq11 f = forward_eq11(c.v / c.l, c.T, steps, 200);
+    const std::string reading =
+        "(11) and (18) integrated forwards from the printed q(0) = (1.32, 16, 1640) under u = q12 phi + q22 delta "
+        "(RK4, dt / 200)";
+    if (!f.finite) {
+      result.table.add_none("poly/eq11-forward/phi", "none", reading);
+      result.table.add_none("poly/eq11-forward/J", "none", reading);
+      result.table.explain("poly/eq11-forward/phi", "escapes to infinity forwards");
+    } else {
+      const std::string qT = "; it ends at Q(T) = (" + number(f.q[0]) + ", " + number(f.q[1]) + ", " + number(f.q[2]) +
+                             "), not the terminal condition (1, 0, 0)";
+      result.table.add("poly/eq11-forward/phi", f.phi, 0.0, reading + qT);
+      result.table.add("poly/eq11-forward/J", f.J, 0.0, reading + qT + ";" + halves);
+      if (result.table.verdict("poly/eq11-forward/J") == does_not_reproduce)
+        result.table.explain(
+            "poly/eq11-forward/J",
+            "impossible under the stated cost: the optimum over all controls is J* = " + number(optimum.J) +
+                "; this run's control energy alone is " + number(f.J - (f.phi - 1) * (f.phi - 1)));
+    }
+  }
 
   // Why the printed polynomial phi(T) cannot be reached cheaply: phi(T) - phi(0) = (v/l) int tan(delta) dt.
   char findings[1600];
@@ -237,6 +303,14 @@ ExampleResult reproduce_regulator(const RegulatorCase& c, const ReproduceSetting
       "direct): its summary.json, timeseries.csv, figures and report.md. The printed readings and the optimum's path "
       "are computed by the same engine (engine/control/poly3_regulator.hpp, direct_optimum.hpp).\n" +
       findings +
+      (c.enotes
+           ? std::string("- The printed q(0) = (1.32, 16, 1640) taken at its word (row `poly/eq11-forward`): (11) and "
+                         "(18) integrated forwards from it reach phi(0.1) close to the printed 0.989, so that is how "
+                         "the paper's phi was obtained; but Q(T) then misses the terminal condition (1, 0, 0) (see the "
+                         "reading), and the control that gets there costs int u^2 far above the printed J. Backwards "
+                         "from Q(T) = diag(1, 0), (11) escapes to infinity within T: no solution of the stated "
+                         "boundary problem exists under (11).\n")
+           : std::string()) +
       "- Tolerance: J is dominated by (1 - phi(T))^2, so 1% of J (about 0.007) is wider than the spread of every law "
       "here, the uncontrolled plant included; J rows agree easily and phi(T), delta(T) (and q(0)) are the numbers "
       "that tell the readings apart.\n"

@@ -150,6 +150,9 @@ if example == "basin-regulator-enotes":
         assert rows[f"poly/{reading}/J"]["verdict"] == "does not reproduce"
         assert rows[f"poly/{reading}/J"]["why"].startswith("impossible under the stated cost"), rows[f"poly/{reading}/J"]
     assert rows["poly/eq11/phi"]["ours"] == "none" and "escaped to infinity" in rows["poly/eq11/phi"]["why"]
+    # Forwards from the printed q(0), (11) gives the printed phi(0.1) = 0.989, at a control energy far above J.
+    assert rows["poly/eq11-forward/phi"]["verdict"] == "reproduces", rows["poly/eq11-forward/phi"]
+    assert ours("poly/eq11-forward/J") > 10 and "impossible" in rows["poly/eq11-forward/J"]["why"]
 if example == "basin-car-regulator":
     assert not any(rows[k]["why"] for k in rows if k.endswith("/J")), "T = 0.3: no printed J is impossible"
     assert ours("none/J") > optimum
