@@ -85,6 +85,9 @@ struct Example {
 const Example examples[] = {
     {"basin-car-filter", reproduce_basin_car_filter, false, 20.0, 2.5e-4, 1, 0},
     {"basin-terpolymer", reproduce_basin_terpolymer, false, 10.0, 1e-3, 1, 0},
+    {"basin-car-regulator", reproduce_basin_car_regulator, false, 0.3, 5e-4, 1, 0},
+    {"basin-regulator-enotes", reproduce_basin_regulator_enotes, false, 0.1, 5e-4, 1, 0},
+    {"basin-car-controller", reproduce_basin_car_controller, true, 0.3, 2e-3, 1000, 0},
     {"sunahara-ex1", reproduce_sunahara_ex1, true, 10.0, 2e-3, 100, 1024},
     {"sunahara-ex2", reproduce_sunahara_ex2, true, 5.0, 2e-3, 100, 1024},
 };
@@ -100,6 +103,9 @@ const Example& find_example(const std::string& name) {
 
 /// The example's sizes with the command line's overrides; InputError for anything the run cannot use.
 ReproduceSettings resolve(const Example& e, const ReproduceOptions& o) {
+  KUSHNER_INPUT_REQUIRE(!o.particles || e.particles > 0,
+                        "--particles: " << e.name << " runs no particle filter; --members, --seed, --dt, --quiet and "
+                                        << "--no-plots apply");
   if (!e.stochastic) {
     KUSHNER_INPUT_REQUIRE(!o.members && !o.particles && !o.seed,
                           (o.members     ? "--members"
@@ -119,7 +125,7 @@ ReproduceSettings resolve(const Example& e, const ReproduceOptions& o) {
   KUSHNER_INPUT_REQUIRE(
       s.members > 0 && s.members <= std::numeric_limits<std::int32_t>::max(),
       "--members: must be in 1 .. " << std::numeric_limits<std::int32_t>::max() << " (got " << s.members << ")");
-  KUSHNER_INPUT_REQUIRE(!e.stochastic || s.particles >= 1,
+  KUSHNER_INPUT_REQUIRE(!e.stochastic || e.particles == 0 || s.particles >= 1,
                         "--particles: must be at least 1 (got " << s.particles << ")");
   KUSHNER_INPUT_REQUIRE(s.seed >= 0 && s.seed <= 0xffffffffLL,
                         "--seed: must be in 0 .. 4294967295 (got " << s.seed << ")");
@@ -135,7 +141,8 @@ nlohmann::json rows_json(const ReproductionTable& table) {
   nlohmann::json rows = nlohmann::json::array();
   for (const ReproductionRow& r : table.rows()) {
     nlohmann::json j = {{"key", r.paper.key},   {"quantity", r.paper.quantity}, {"paper", r.paper.paper},
-                        {"verdict", r.verdict}, {"reading", r.reading},         {"source", r.paper.source}};
+                        {"verdict", r.verdict}, {"reading", r.reading},         {"source", r.paper.source},
+                        {"why", r.why}};
     if (r.ours_text.empty()) {
       j["ours"] = r.ours;
       j["standard_error"] = r.standard_error;
@@ -156,12 +163,18 @@ std::string multi_run_report(const std::string& example, const nlohmann::json& s
                        summary.value("git", std::string("?")) + "), backend " +
                        backend.value("name", std::string("?")) + "\n\n" + table + "\n## Runs\n\n";
   for (const std::string& run : runs) {
-    report += "### " + run + "\n\n[report](" + run + "/report.md) · `" + run + "/summary.json` · `" + run +
-              "/timeseries.csv` · `" + run + "/trajectories.csv`\n\n";
-    for (const char* figure : {"estimates", "errors", "rmse_ref"})
-      if (std::find(summary["runs"][run]["files"].begin(), summary["runs"][run]["files"].end(),
-                    std::string(figure) + ".png") != summary["runs"][run]["files"].end())
-        report += "![" + run + " " + figure + "](" + run + "/" + figure + ".png)\n\n";
+    report += "### " + run + "\n\n[report](" + run + "/report.md)";
+    for (const auto& file : summary["runs"][run]["files"]) {
+      const std::string name = file.get<std::string>();
+      if (name.size() > 4 && (name.compare(name.size() - 4, 4, ".csv") == 0 || name == "summary.json"))
+        report += " · `" + run + "/" + name + "`";
+    }
+    report += "\n\n";
+    for (const auto& file : summary["runs"][run]["files"]) {  // its figures: estimates, errors, ... or control_paths
+      const std::string name = file.get<std::string>();
+      if (name.size() > 4 && name.compare(name.size() - 4, 4, ".png") == 0)
+        report += "![" + run + " " + name.substr(0, name.size() - 4) + "](" + run + "/" + name + ")\n\n";
+    }
     if (summary["runs"][run].contains("plots_error")) {  // "no figures: ..." or "plotting failed: ..."
       std::string why = summary["runs"][run]["plots_error"].get<std::string>();
       why[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(why[0])));
@@ -181,11 +194,11 @@ int run_reproduce(const ReproduceOptions& options, const RunContext& context_in)
   // A deterministic example is one member stepped tens of thousands of times: OpenMP's fork and join per kernel,
   // or a GPU's launch and copy latency per step, costs far more than the work (basin-car-filter: 14 s on Serial,
   // over 200 s on an H100). Unless KUSHNER_BACKEND asks otherwise, it runs on Serial, which gives the same bits
-  // as OpenMP.
+  // as OpenMP. So does an example without a particle filter (basin-car-controller: 1000 members of dimension 2).
   const char* asked = std::getenv("KUSHNER_BACKEND");
   const std::vector<std::string> backends = available_backends();
-  if (!example.stochastic && (asked == nullptr || *asked == '\0') && context.backend != "serial" &&
-      std::find(backends.begin(), backends.end(), "serial") != backends.end())
+  if ((!example.stochastic || example.particles == 0) && (asked == nullptr || *asked == '\0') &&
+      context.backend != "serial" && std::find(backends.begin(), backends.end(), "serial") != backends.end())
     context.backend = "serial";
   const OutputDirectory out(options.out, "--out");
   KokkosSession kokkos;

@@ -68,6 +68,12 @@ ExampleResult reproduce_sunahara_ex2(const ReproduceSettings& settings, const Ru
                                      const OutputDirectory& out);
 ExampleResult reproduce_basin_car_filter(const ReproduceSettings& settings, const RunContext& context,
                                          const OutputDirectory& out);
+ExampleResult reproduce_basin_car_regulator(const ReproduceSettings& settings, const RunContext& context,
+                                            const OutputDirectory& out);
+ExampleResult reproduce_basin_regulator_enotes(const ReproduceSettings& settings, const RunContext& context,
+                                               const OutputDirectory& out);
+ExampleResult reproduce_basin_car_controller(const ReproduceSettings& settings, const RunContext& context,
+                                             const OutputDirectory& out);
 ExampleResult reproduce_basin_terpolymer(const ReproduceSettings& settings, const RunContext& context,
                                          const OutputDirectory& out);
 

@@ -165,6 +165,30 @@ void ReproductionTable::add_text(const std::string& key, const std::string& ours
   r.verdict = r.paper.paper.empty() ? no_number : holds ? reproduces : does_not_reproduce;
 }
 
+void ReproductionTable::add_none(const std::string& key, const std::string& ours, const std::string& reading) {
+  ReproductionRow& r = row(key);
+  r.ours_text = ours;
+  r.reading = reading;
+  r.verdict = r.paper.paper.empty() ? no_number : does_not_reproduce;
+}
+
+void ReproductionTable::explain(const std::string& key, const std::string& why) {
+  for (std::size_t i = 0; i < rows_.size(); ++i)
+    if (rows_[i].paper.key == key) {
+      KUSHNER_REQUIRE(filled_[i], "reproduction row '" << key << "' explained before it was filled");
+      rows_[i].why = why;
+      return;
+    }
+  KUSHNER_REQUIRE(false, "no row '" << key << "' in the paper values of " << example_);
+}
+
+const std::string& ReproductionTable::verdict(const std::string& key) const {
+  for (std::size_t i = 0; i < rows_.size(); ++i)
+    if (rows_[i].paper.key == key && filled_[i]) return rows_[i].verdict;
+  KUSHNER_REQUIRE(false, "no filled row '" << key << "' in the paper values of " << example_);
+  return rows_.front().verdict;
+}
+
 const std::vector<ReproductionRow>& ReproductionTable::rows() const {
   for (std::size_t i = 0; i < rows_.size(); ++i)
     KUSHNER_REQUIRE(filled_[i], "reproduction row '" << rows_[i].paper.key << "' of " << example_ << " has no value");
@@ -172,12 +196,12 @@ const std::vector<ReproductionRow>& ReproductionTable::rows() const {
 }
 
 std::string ReproductionTable::csv(const std::string& comment) const {
-  std::string out = comment + "example,key,quantity,paper,ours,standard_error,verdict,reading,source\n";
+  std::string out = comment + "example,key,quantity,paper,ours,standard_error,verdict,reading,source,why\n";
   for (const ReproductionRow& r : rows())
     out += example_ + "," + csv_field(r.paper.key) + "," + csv_field(r.paper.quantity) + "," +
            csv_field(r.paper.paper) + "," + (r.ours_text.empty() ? format_number(r.ours) : csv_field(r.ours_text)) +
            "," + format_number(r.standard_error) + "," + csv_field(r.verdict) + "," + csv_field(r.reading) + "," +
-           csv_field(r.paper.source) + "\n";
+           csv_field(r.paper.source) + "," + csv_field(r.why) + "\n";
   return out;
 }
 
@@ -191,8 +215,8 @@ std::string ReproductionTable::markdown(const std::string& notes) const {
   out += "| quantity | paper | ours | verdict | reading | source |\n|---|---|---|---|---|---|\n";
   for (const ReproductionRow& r : rows())
     out += "| " + r.paper.quantity + " | " + (r.paper.paper.empty() ? "–" : r.paper.paper) + " | " +
-           (r.ours_text.empty() ? format_ours(r.ours, r.standard_error) : r.ours_text) + " | " + r.verdict + " | " +
-           r.reading + " | " + r.paper.source + " |\n";
+           (r.ours_text.empty() ? format_ours(r.ours, r.standard_error) : r.ours_text) + " | " + r.verdict +
+           (r.why.empty() ? "" : ": " + r.why) + " | " + r.reading + " | " + r.paper.source + " |\n";
   return out;
 }
 
@@ -204,7 +228,7 @@ std::string ReproductionTable::text() const {
   for (const ReproductionRow& r : rows())
     out += pad(r.paper.quantity, width) + "  " + pad(r.paper.paper.empty() ? "-" : r.paper.paper, 10) + "  " +
            pad(r.ours_text.empty() ? format_ours(r.ours, r.standard_error, "+-") : r.ours_text, 18) + "  " + r.verdict +
-           "\n";
+           (r.why.empty() ? "" : " (" + r.why + ")") + "\n";
   return out;
 }
 

@@ -38,6 +38,7 @@ struct ReproductionRow {
   std::string ours_text;        // instead of `ours`, for counts and claims
   std::string verdict;
   std::string reading;  // which reading of the paper produced `ours`
+  std::string why;      // why it does not reproduce, where we know (e.g. "impossible under the stated cost: ...")
 };
 
 class ReproductionTable {
@@ -50,12 +51,19 @@ class ReproductionTable {
   /// Our outcome in words for a row whose paper value is a claim (`holds`: whether ours agrees with it) or
   /// absent (`holds` ignored).
   void add_text(const std::string& key, const std::string& ours, bool holds, const std::string& reading);
+  /// No number of ours for a row whose paper value is a number (our equations have no solution there, say):
+  /// `ours` in words, the verdict `does not reproduce` (or `no number in paper`).
+  void add_none(const std::string& key, const std::string& ours, const std::string& reading);
+  /// Why row `key` (filled already) does not reproduce; shown after its verdict.
+  void explain(const std::string& key, const std::string& why);
+  /// The verdict of row `key` (filled already).
+  const std::string& verdict(const std::string& key) const;
 
   /// KUSHNER_REQUIRE that every row of the data file has our value; rows in data-file order.
   const std::vector<ReproductionRow>& rows() const;
   const std::string& example() const { return example_; }
 
-  /// reproduction.csv: example,key,quantity,paper,ours,standard_error,verdict,reading,source (numbers %.17g).
+  /// reproduction.csv: example,key,quantity,paper,ours,standard_error,verdict,reading,source,why (numbers %.17g).
   std::string csv(const std::string& comment) const;
   /// reproduction.md: a heading, `notes` (markdown, what the example ran and which readings it used), the
   /// tolerance rule, and the table.

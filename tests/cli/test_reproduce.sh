@@ -94,6 +94,89 @@ grep -q "^claim: BILIN gives the best estimate of the three filters .*BILIN best
   || fail "basin-terpolymer: the claim row is missing: $(cat "$work/terp.out")"
 echo "ok: sunahara-ex1, sunahara-ex2, basin-terpolymer"
 
+# Basin's regulators and controller (seed 002): files, every row of the data files on stdout with a verdict, and
+# numbers that can fail: the printed linear q(0) to its printed digits, the direct optimum at most every law's J,
+# the impossible printed J explained, the controller's loops equal to `kushner control`'s.
+for example in basin-regulator-enotes basin-car-regulator basin-car-controller; do
+  extra=()
+  [ "$example" = basin-car-controller ] && extra=(--members 200)
+  run_kushner "$work/$example" reproduce "$example" --out "$work/$example" --quiet --no-plots "${extra[@]}"
+  [ "$rc" -eq 0 ] || fail "reproduce $example failed: $(cat "$work/$example.err")"
+  for f in summary.json reproduction.csv reproduction.md; do
+    [ -s "$work/$example/$f" ] || fail "reproduce $example did not write $f"
+  done
+  runs=(control)
+  [ "$example" = basin-car-controller ] && runs=(control-sine control-brownian)
+  for run in "${runs[@]}"; do
+    for f in summary.json timeseries.csv; do
+      [ -s "$work/$example/$run/$f" ] || fail "reproduce $example did not write $run/$f"
+    done
+  done
+  csvname=${example//-/_}
+  "$python" - "$source_dir/drivers/reproduce/$csvname.csv" "$work/$example.out" "$work/$example/reproduction.csv" \
+    "$work/$example/summary.json" "$example" <<'PY' || fail "reproduce $example: table or numbers wrong"
+import csv, json, math, sys
+data = list(csv.DictReader(l for l in open(sys.argv[1]) if not l.startswith("#")))
+out = open(sys.argv[2]).read().splitlines()
+rows = {r["key"]: r for r in csv.DictReader(l for l in open(sys.argv[3]) if not l.startswith("#"))}
+summary, example = json.load(open(sys.argv[4])), sys.argv[5]
+assert [d["key"] for d in data] == list(rows), "rows differ from the data file"
+for d in data:
+    lines = [l for l in out if l.startswith(d["quantity"] + " ")]
+    assert len(lines) == 1, f"stdout has {len(lines)} lines for {d['quantity']!r}"
+    fields = lines[0][len(d["quantity"]):].split()
+    assert fields[0] == (d["paper"] or "-"), (d["quantity"], fields)
+    verdict = rows[d["key"]]["verdict"]
+    assert verdict in ("reproduces", "does not reproduce", "no number in paper"), verdict
+    assert (verdict == "no number in paper") == (not d["paper"]), (d["key"], verdict)
+    assert verdict in lines[0], (d["quantity"], lines[0])
+def ours(key):
+    return float(rows[key]["ours"])
+optimum = ours("optimum/J")
+# The direct optimum is a floor: no law (printed or ours) has a smaller J (rounding of the optimizer allowed).
+laws = [k for k in rows if k.endswith("/J") and not k.startswith("optimum") and rows[k]["ours"] != "none"]
+assert laws, "no law rows"
+for k in laws:
+    assert ours(k) >= optimum - 1e-6 * abs(optimum), f"{k}: J {ours(k)} below the optimum {optimum}"
+if example == "basin-regulator-enotes":
+    # Our printed linear regulator (12): q(0) = (1.025, 0.87, 0.74) to the printed digits.
+    for q, printed, half in (("q11", 1.025, 5e-4), ("q12", 0.87, 5e-3), ("q22", 0.74, 5e-3)):
+        assert abs(ours(f"linear/printed/{q}") - printed) <= half, (q, ours(f"linear/printed/{q}"))
+        assert rows[f"linear/printed/{q}"]["verdict"] == "reproduces"
+    # The printed polynomial J = 0.065 is below the optimum 0.648: impossible, and said so.
+    assert 0.64 < optimum < 0.66, optimum
+    assert abs(ours("optimum/J_half") - optimum / 2) < 1e-12
+    for reading in ("derived", "general", "eq23"):
+        assert rows[f"poly/{reading}/J"]["verdict"] == "does not reproduce"
+        assert rows[f"poly/{reading}/J"]["why"].startswith("impossible under the stated cost"), rows[f"poly/{reading}/J"]
+    assert rows["poly/eq11/phi"]["ours"] == "none" and "escaped to infinity" in rows["poly/eq11/phi"]["why"]
+    # Forwards from the printed q(0), (11) gives the printed phi(0.1) = 0.989, at a control energy far above J.
+    assert rows["poly/eq11-forward/phi"]["verdict"] == "reproduces", rows["poly/eq11-forward/phi"]
+    assert ours("poly/eq11-forward/J") > 10 and "impossible" in rows["poly/eq11-forward/J"]["why"]
+if example == "basin-car-regulator":
+    assert not any(rows[k]["why"] for k in rows if k.endswith("/J")), "T = 0.3: no printed J is impossible"
+    assert ours("none/J") > optimum
+if example == "basin-car-controller":
+    # Basin's printed linear controller on KBL with sin t noises reproduces the paper's phi(0.3) = 0.0545.
+    assert rows["sine/linear/printed/phi"]["verdict"] == "reproduces", rows["sine/linear/printed/phi"]
+    assert abs(ours("sine/linear/printed/phi") - 0.0545) < 0.002
+    assert float(rows["brownian/linear/LINCTL/J"]["standard_error"]) > 0
+    # The table's own loops equal `kushner control`'s runs (same closed-loop code, seed, members).
+    for noise in ("sine", "brownian"):
+        ctl = summary["runs"]["control-" + noise]["controllers"]
+        assert abs(ctl["LINCTL"]["J"] - ours(f"{noise}/linear/LINCTL/J")) <= 1e-9 * ours(f"{noise}/linear/LINCTL/J")
+        assert abs(ctl["POLYCTL"]["J"] - ours(f"{noise}/poly/POLYCTL/J")) <= 1e-9 * ours(f"{noise}/poly/POLYCTL/J")
+        assert abs(summary["runs"]["control-" + noise]["reference"]["J"] - optimum) <= 1e-9 * optimum
+else:
+    ctl = summary["runs"]["control"]
+    assert abs(ctl["reference"]["J"] - optimum) <= 1e-9 * optimum
+    assert abs(ctl["controllers"]["POLYREG"]["J"] - ours("poly/derived/J")) <= 1e-12 * optimum
+    for name, c in ctl["controllers"].items():
+        assert c["J"] >= optimum - 1e-6 * optimum, (name, c["J"], optimum)
+print(f"ok: {example}: {len(rows)} rows, optimum J* = {optimum:.6g}")
+PY
+done
+
 expect_refused() {  # expect_refused "message fragment" args...: one line, exit 2, nothing written
   local expected=$1; shift
   run_kushner "$work/r" "$@"
@@ -104,10 +187,12 @@ expect_refused() {  # expect_refused "message fragment" args...: one line, exit 
   [ ! -e "$work/refused" ] || fail "a refused run created its output directory: $*"
   echo "ok: $(cat "$work/r.err")"
 }
-expect_refused "reproduce: unknown example 'basin-car' (known: basin-car-filter, basin-terpolymer, sunahara-ex1, sunahara-ex2)" \
+expect_refused "reproduce: unknown example 'basin-car' (known: basin-car-filter, basin-terpolymer, basin-car-regulator, basin-regulator-enotes, basin-car-controller, sunahara-ex1, sunahara-ex2)" \
   reproduce basin-car --out "$work/refused"
 expect_refused "--out is required" reproduce basin-car-filter
 expect_refused "--members: basin-car-filter is deterministic" reproduce basin-car-filter --members 10 --out "$work/refused"
+expect_refused "--seed: basin-car-regulator is deterministic" reproduce basin-car-regulator --seed 3 --out "$work/refused"
+expect_refused "--particles: basin-car-controller runs no particle filter" reproduce basin-car-controller --particles 64 --out "$work/refused"
 expect_refused "--seed: basin-terpolymer is deterministic" reproduce basin-terpolymer --seed 3 --out "$work/refused"
 expect_refused "--dt: the horizon of basin-car-filter, T = 20, must be a whole number of steps" reproduce basin-car-filter --dt 0.3 --out "$work/refused"
 expect_refused "--dt: must be positive (got -0.1)" reproduce sunahara-ex1 --dt -0.1 --out "$work/refused"

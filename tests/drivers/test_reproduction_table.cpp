@@ -42,7 +42,8 @@ TEST(ReproductionTable, VerdictsFollowThePaperValue) {
 TEST(ReproductionTable, EveryExampleHasItsDataFile) {
   const std::vector<std::string> examples = paper_value_examples();
   EXPECT_EQ(examples,
-            (std::vector<std::string>{"basin-car-filter", "basin-terpolymer", "sunahara-ex1", "sunahara-ex2"}));
+            (std::vector<std::string>{"basin-car-controller", "basin-car-filter", "basin-car-regulator",
+                                      "basin-regulator-enotes", "basin-terpolymer", "sunahara-ex1", "sunahara-ex2"}));
   const std::vector<PaperValue> car = paper_values("basin-car-filter");
   ASSERT_EQ(car.size(), 24u);
   EXPECT_EQ(car[2].key, "taylor/KB/m_phi");
@@ -64,6 +65,32 @@ TEST(ReproductionTable, ClaimsTakeWordsAndGetAVerdict) {
   }
   ReproductionTable table("basin-terpolymer");
   EXPECT_THROW(table.add("claim/bilinear_best", 1.0, 0.0, "r"), std::logic_error) << "a claim is not a number";
+}
+
+// A printed number without one of ours (no solution of our equations) does not reproduce; `explain` says why, in
+// the verdict cell of the markdown, after the verdict on stdout and in the csv's `why` column.
+TEST(ReproductionTable, RowsWithoutOurNumberAndWhy) {
+  ReproductionTable table("basin-regulator-enotes");
+  for (const PaperValue& v : paper_values("basin-regulator-enotes"))
+    if (v.key.rfind("poly/eq11/", 0) == 0)
+      table.add_none(v.key, "none", "r");
+    else
+      table.add(v.key, 0.6479, 0.0, "r");
+  EXPECT_THROW(table.explain("no/such/key", "x"), std::logic_error);
+  table.explain("poly/eq11/phi", "escapes to infinity");
+  table.explain("poly/derived/J", "impossible under the stated cost");
+  EXPECT_EQ(table.verdict("poly/eq11/phi"), does_not_reproduce);
+  EXPECT_EQ(table.verdict("poly/derived/J"), does_not_reproduce);
+  EXPECT_EQ(table.verdict("none/J"), no_number);
+  EXPECT_NE(table.text().find("none                does not reproduce (escapes to infinity)"), std::string::npos)
+      << table.text();
+  EXPECT_NE(table.markdown("").find("| does not reproduce: impossible under the stated cost |"), std::string::npos);
+  const std::string csv = table.csv("");
+  EXPECT_EQ(csv.substr(0, csv.find('\n')), "example,key,quantity,paper,ours,standard_error,verdict,reading,source,why");
+  EXPECT_NE(csv.find("poly/eq11/phi,"), std::string::npos);
+  EXPECT_NE(csv.find(",none,0,does not reproduce,r,\"002 L1969, table, row 1, column 2\",escapes to infinity"),
+            std::string::npos)
+      << csv;
 }
 
 }  // namespace
