@@ -21,7 +21,7 @@ struct ParticleTeamPairStep {
   ParticleStepData<Model, MemSpace> d;       // step k: its inputs, increments and partials
   ParticleSecondStep<Model, MemSpace> next;  // step k + 1: its outputs, increments and partials
   // No control: a closed loop's second control depends on the first step's posterior (step_pair refuses one).
-  static constexpr typename Model::Control uncontrolled = Model::Control::zero();
+  KOKKOS_INLINE_FUNCTION static typename Model::Control uncontrolled() { return Model::Control::zero(); }
 
   static std::size_t scratch_bytes(int team_size) { return team_sum_scratch_bytes<n>(team_size); }
 
@@ -89,7 +89,7 @@ struct ParticleTeamPairStep {
           const int j = batch_particle(base, k, c.threads);
           if (j >= c.end) continue;
           const double l = update_particle<false>(d, step_time(s), precision(s), z[k], u[k], lw[k],
-                                                  s == 0 ? log_normalizer : 0.0, vinv_dy[s], uncontrolled, x[k]);
+                                                  s == 0 ? log_normalizer : 0.0, vinv_dy[s], uncontrolled(), x[k]);
           if (s == 1) {
             KUSHNER_DEVICE_UNROLL
             for (int i = 0; i < n; ++i) xo[j + i * stride] = x[k][i];
@@ -120,7 +120,7 @@ struct ParticleTeamPairStep {
         if (j >= c.end) continue;
         Vec<n> x = load_particle<n>(d.x, j, member);
         const double l = update_particle<false>(d, d.t, d.observation_precision, z[k], u[k], d.log_weight(j, member),
-                                                log_normalizer, vinv_dy, uncontrolled, x);
+                                                log_normalizer, vinv_dy, uncontrolled(), x);
         add_shifted_particle(l - shift, x - ref, w);
       }
     }
