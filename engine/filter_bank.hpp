@@ -108,7 +108,8 @@ class FilterBank {
         slot.enabled = true;
         const std::optional<Filter>& ready = std::get<std::optional<Filter>>(prepared);
         slot.filter =
-            ready ? *ready : Filter::create(options.with_defaults(filter_options<Filter>()), filter_model, members);
+            ready ? *ready
+                  : create_filter<Filter>(options.with_defaults(filter_options<Filter>()), filter_model, members, seed);
         slot.m = BankVector<MemSpace>(std::string("kushner::m_") + Filter::name, members, n);
         slot.P = BankSymmetric<MemSpace>(std::string("kushner::P_") + Filter::name, members, packed_size(n));
         slot.status = BankScalar<Status, MemSpace>(std::string("kushner::status_") + Filter::name, members);

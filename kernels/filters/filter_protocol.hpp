@@ -16,11 +16,17 @@
 //   template <class RunAlone>                                 // the pre-pass itself: run_alone(filter) runs the
 //   static Filter prepare(const OptionValues&, const Model&, long members, RunAlone&&);  // truths with it alone
 //   Fields summary_fields() const;                            // what it adds to its summary.json entry
+//   static Filter create(const OptionValues&, const Model&, long members, std::uint32_t seed);  // instead of
+//                                                             // the create above: a filter that draws random
+//   static constexpr bool randomized = true;                  // numbers gets the run's seed, and says so
+//
+// Filters may declare the same option (equal OptionSpec): it is one setting, shared.
 #include "core/fields.hpp"
 #include "core/options.hpp"
 #include "models/drift_facts.hpp"
 #include "models/model_traits.hpp"
 
+#include <cstdint>
 #include <optional>
 #include <type_traits>
 #include <utility>
@@ -50,6 +56,19 @@ template <class Filter, class = void>
 struct has_prepass : std::false_type {};
 template <class Filter>
 struct has_prepass<Filter, std::void_t<decltype(Filter::prepass_passes)>> : std::true_type {};
+
+template <class Filter, class Model, class = void>
+struct has_seeded_create : std::false_type {};
+template <class Filter, class Model>
+struct has_seeded_create<Filter, Model,
+                         std::void_t<decltype(Filter::create(std::declval<const OptionValues&>(),
+                                                             std::declval<const Model&>(), 0L, std::uint32_t{}))>>
+    : std::true_type {};
+
+template <class Filter, class = void>
+struct is_randomized : std::false_type {};
+template <class Filter>
+struct is_randomized<Filter, std::enable_if_t<Filter::randomized>> : std::true_type {};
 
 template <class Filter, class = void>
 struct has_summary_fields : std::false_type {};
@@ -85,6 +104,21 @@ const char* filter_unsupported(const Model& model) {
     return Filter::unsupported_by(model.drift_facts());
   else
     return nullptr;
+}
+
+/// Filter::create; a randomized filter's create also takes the run's seed.
+template <class Filter, class Model>
+Filter create_filter(const OptionValues& options, const Model& model, long members, std::uint32_t seed) {
+  if constexpr (detail::has_seeded_create<Filter, Model>::value)
+    return Filter::create(options, model, members, seed);
+  else
+    return Filter::create(options, model, members);
+}
+
+/// Whether Filter draws random numbers (a Monte Carlo filter: equal to another only in the limit).
+template <class Filter>
+constexpr bool filter_randomized() {
+  return detail::is_randomized<Filter>::value;
 }
 
 /// How many passes over the horizon Filter's pre-pass takes (0: none).
