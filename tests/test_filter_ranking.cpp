@@ -5,7 +5,7 @@
 // independent members a false ranking has probability below 3e-5 per pair. Every ranking is also checked to FAIL
 // when the reference is perturbed: the reference mean drawn 90% of the way towards the worst filter's estimate
 // (the particle filter replaced by something close to that filter) must reverse it.
-// Sizes (fixed seeds): 200 members, 1024 particles, dt = 0.01 unless a test says otherwise; the PF's own noise
+// Sizes (fixed seeds): 200 members, 512 particles, dt = 0.01 unless a test says otherwise; the PF's own noise
 // floor (summary `noise_floor`) and each pair's paired difference in standard errors are printed with each ranking.
 // The terpolymer (10 states) is ranked against the truths instead (see its test).
 #include "engine/filter_bank.hpp"
@@ -97,7 +97,7 @@ struct MemberErrors {
 };
 
 struct RunSpec {
-  long members = 200, particles = 1024, steps = 1000;  // particles 0: the truths are the reference
+  long members = 200, particles = 512, steps = 1000;  // particles 0: the truths are the reference
   double dt = 0.01;
   std::uint32_t seed = 20261125;
 };
@@ -200,13 +200,13 @@ void expect_ranking(const Model& model, const std::vector<std::string>& order, c
   EXPECT_FALSE(ranked(off, order, why)) << Model::name << " with a perturbed reference: " << table(off, order);
 }
 
-/// Seed 000 Example 1 in a hard regime: q = 1, r = 2, x(0) ~ N(0, 4) (truths and filters); T = 10, 200 members.
+/// Seed 000 Example 1 in a hard regime: q = 1, r = 2, x(0) ~ N(0, 4) (truths and filters); T = 10, 400 members.
 TEST(FilterRanking, SineHardRegimeQlfSofEkf) {
   SineModel model;
   model.q = 1.0, model.r = 2.0;
   model.set_initial_law(Vec<1>{{0.0}}, Mat<1, 1>{{{4.0}}});
   RunSpec spec;
-  spec.members = 200;
+  spec.members = 400;
   expect_ranking(model, {"QLF", "SOF", "EKF"}, spec);
 }
 
@@ -229,18 +229,18 @@ TEST(FilterRanking, TerpolymerBilinBeforeKbl) {
 
 /// The cubic sensor (dy = x^3 dt + r dv; sigma = r = 1, x(0) ~ N(1, 1)): the quasi-linear filter, whose E[x^3] and
 /// E[3 x^2] see the spread, before the EKF, whose gain 3 m^2 P vanishes near m = 0, before KBL (h'(0) = 0: no
-/// update at all). T = 5, dt = 0.01, 200 members.
+/// update at all). T = 5, dt = 0.01, 300 members.
 TEST(FilterRanking, CubicSensorQlfEkfKbl) {
   RunSpec spec;
-  spec.members = 200, spec.steps = 500;
+  spec.members = 300, spec.steps = 500;
   expect_ranking(CubicSensorModel{}, {"QLF", "EKF", "KBL"}, spec);
 }
 
 /// The pendulum observed through sin x1 (g = 9.81, q = r = 0.5, x(0) ~ N((1.5, 0), 0.1 I)): QLF before EKF.
-/// T = 2, dt = 2e-3 (Euler-Maruyama's energy gain, models/pendulum_model.hpp), 200 members.
+/// T = 2, dt = 2e-3 (Euler-Maruyama's energy gain, models/pendulum_model.hpp), 100 members.
 TEST(FilterRanking, PendulumQlfEkf) {
   RunSpec spec;
-  spec.members = 200, spec.steps = 1000, spec.dt = 2e-3;
+  spec.members = 100, spec.steps = 1000, spec.dt = 2e-3;
   expect_ranking(PendulumModel{}, {"QLF", "EKF"}, spec);
 }
 
