@@ -66,7 +66,7 @@ void add_compare_options(CLI::App& app, CompareOptions& o) {
       ->delimiter(',')
       ->capture_default_str();
   app.add_option("--density-times", o.density_times,
-                 "1-D models: times of the density snapshots (comma-separated; default T/10, T/2, T)")
+                 "times of the density snapshots of x1 (comma-separated; default T/10, T/2, T)")
       ->delimiter(',');
   app.add_flag("!--no-plots", o.plots, "write the CSV and JSON files only (no plots, no report.md)");
 }

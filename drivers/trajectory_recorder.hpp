@@ -1,8 +1,9 @@
 #pragma once
 // What `kushner compare` shows for a few chosen members, recorded at the run's output times: the truth, each
-// filter's estimate with its +-2 sigma band, the particle mean with its 5-95% band (trajectories.csv); and for
-// 1-D models the particle density of the first chosen member against each filter's Gaussian at chosen times
-// (density.csv). Only those members are copied to the host, so it costs little next to the run.
+// filter's estimate with its +-2 sigma band, the particle mean with its 5-95% band (trajectories.csv); and the
+// particle density of the first state component (its marginal, for a model of several) of the first chosen
+// member against each filter's Gaussian at chosen times (density.csv). Only those members are copied to the host, so it
+// costs little next to the run.
 #include "core/errors.hpp"
 #include "drivers/csv.hpp"
 #include "drivers/run_metadata.hpp"
@@ -27,7 +28,7 @@ class TrajectoryRecorder {
   static constexpr int n = Model::state_dim;
   static constexpr int density_bins = 80;
 
-  /// `members`: the members to follow (each below `num_members`); `density_times`: for 1-D models, the
+  /// `members`: the members to follow (each below `num_members`); `density_times`: the density
   /// snapshots are taken at the first output time at or after each of them.
   TrajectoryRecorder(const std::vector<long>& members, long num_members, std::vector<double> density_times)
       : members_(members), density_times_(std::move(density_times)) {
@@ -51,8 +52,7 @@ class TrajectoryRecorder {
       snapshot = e->particle_snapshot(members);
       if (snapshot) pf = e;
     }
-    const bool density =
-        n == 1 && pf && next_density_ < density_times_.size() && t >= density_times_[next_density_] - 1e-9;
+    const bool density = pf && next_density_ < density_times_.size() && t >= density_times_[next_density_] - 1e-9;
     for (int member : members) {
       const auto x = row(bank.truths().state(), member);
       for (int i = 0; i < n; ++i) add_trajectory(member, t, i, "truth", x(i), x(i), x(i));
@@ -78,7 +78,7 @@ class TrajectoryRecorder {
   }
 
   const std::string& trajectories_csv() const { return trajectories_; }
-  /// Empty unless a density snapshot was taken (1-D model with the particle filter).
+  /// Empty unless a density snapshot was taken (a run with the particle filter).
   std::string density_csv() const { return density_taken_ ? density_ : std::string(); }
 
  private:

@@ -51,14 +51,16 @@ struct FilterScores {
 };
 
 /// Selects filter Filter in its slot: the filter made by its pre-pass (`ready`) or by Filter::create with
-/// `options`, its views for `members` members, every member at the model's prior. Shared by the filter bank and
-/// the closed loops of `kushner control` (engine/control/closed_loop.hpp).
+/// `options` (and the run's seed, for a filter that draws random numbers), its views for `members` members, every
+/// member at the model's prior. Shared by the filter bank and the closed loops of `kushner control`
+/// (engine/control/closed_loop.hpp).
 template <class Filter, class MemSpace, class Model>
 void enable_filter_slot(FilterSlot<Filter, MemSpace>& slot, const Model& model, long members,
-                        const OptionValues& options, const std::optional<Filter>& ready) {
+                        const OptionValues& options, const std::optional<Filter>& ready, std::uint32_t seed) {
   constexpr int n = Model::state_dim;
   slot.enabled = true;
-  slot.filter = ready ? *ready : Filter::create(options.with_defaults(filter_options<Filter>()), model, members);
+  slot.filter =
+      ready ? *ready : create_filter<Filter>(options.with_defaults(filter_options<Filter>()), model, members, seed);
   slot.m = BankVector<MemSpace>(std::string("kushner::m_") + Filter::name, members, n);
   slot.P = BankSymmetric<MemSpace>(std::string("kushner::P_") + Filter::name, members, packed_size(n));
   slot.status = BankScalar<Status, MemSpace>(std::string("kushner::status_") + Filter::name, members);
@@ -130,7 +132,7 @@ class FilterBank {
         using Filter = decltype(slot.filter);
         if (name != Filter::name) return;
         found = true;
-        enable_filter_slot(slot, filter_model, members, options, std::get<std::optional<Filter>>(prepared));
+        enable_filter_slot(slot, filter_model, members, options, std::get<std::optional<Filter>>(prepared), seed);
       });
       KUSHNER_REQUIRE(found, "filter '" << name << "' is not supported by model " << Model::name);
     }

@@ -23,13 +23,15 @@ namespace kushner {
 /// Streams of random numbers; one Philox key each. Values are part of the file format of results
 /// (changing one changes every number a seed gives), so they never change.
 enum class Stream : std::uint32_t {
-  truth_initial = 1,      // initial states of the truths
-  process_noise = 2,      // dw of the truths
-  observation_noise = 3,  // dv of the observations
-  particle_initial = 4,   // initial particles
-  particle_noise = 5,     // dw of the particles
-  resampling = 6,         // uniforms of the resampling schemes
-  filter_initial = 7,     // randomized filter initial conditions
+  truth_initial = 1,       // initial states of the truths
+  process_noise = 2,       // dw of the truths
+  observation_noise = 3,   // dv of the observations
+  particle_initial = 4,    // initial particles
+  particle_noise = 5,      // dw of the particles
+  resampling = 6,          // uniforms of the resampling schemes
+  filter_initial = 7,      // randomized filter initial conditions (the EnKBF's initial ensemble)
+  filter_noise = 8,        // dw of a randomized filter's members (EnKBF)
+  filter_observation = 9,  // perturbed observations of a randomized filter (the stochastic EnKBF)
 };
 
 struct RngKey {

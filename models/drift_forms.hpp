@@ -6,6 +6,9 @@
 //   QuadraticPolynomial  f_k = a0_k + sum_i a1_ki x_i + sum c x_i x_j       (Basin bilinear, seed 002 ACC03 (13))
 //   SdcDrift             f = A(x) x + b                                      (Cimen-Banks ASRE, seed 001 (4))
 //   GaussianDrift        E_N[f], E_N[grad f] under x ~ N(m, P)               (Sunahara QLF, seed 000 (5.3)-(5.4))
+// and of a nonlinear observation:
+//   SdcObservation       h = C(x) x + c0                                     (Cimen-Banks ASRE, seed 001 (5))
+//   GaussianObservation  E_N[h], E_N[grad h] under x ~ N(m, P)               (Sunahara QLF, seed 000 (5.9)-(5.10))
 #include "core/small_matrix.hpp"
 
 namespace kushner {
@@ -88,6 +91,21 @@ template <int N>
 struct GaussianDrift {
   Vec<N> mean;
   Mat<N, N> jacobian;
+};
+
+/// h(x) = C(x) x + c0: a state-dependent-coefficient factorization of the observation (seed 001 (5)).
+template <int N, int P>
+struct SdcObservation {
+  Mat<P, N> C;
+  Vec<P> c0;
+};
+
+/// Gaussian expectations of the observation under x ~ N(m, P): mean = E[h(x)] (seed 000 (5.9)), jacobian =
+/// E[grad h(x)] (= H2 of (5.10) by Stein's lemma).
+template <int N, int P>
+struct GaussianObservation {
+  Vec<P> mean;
+  Mat<P, N> jacobian;
 };
 
 }  // namespace kushner

@@ -8,9 +8,12 @@
 #include "models/car_model.hpp"
 #include "models/clark_linear_model.hpp"
 #include "models/cubic_oscillator_model.hpp"
+#include "models/cubic_sensor_model.hpp"
 #include "models/linear_model.hpp"
 #include "models/ou_model.hpp"
+#include "models/pendulum_model.hpp"
 #include "models/polynomial_model.hpp"
+#include "models/range_bearing_model.hpp"
 #include "models/sine_model.hpp"
 #include "models/terpolymer_model.hpp"
 
@@ -28,7 +31,10 @@
   MODEL(CarModel)                        \
   MODEL(CarTaylor3Model)                 \
   MODEL(TerpolymerModel)                 \
-  MODEL(BenesModel)
+  MODEL(BenesModel)                      \
+  MODEL(CubicSensorModel)                \
+  MODEL(PendulumModel)                   \
+  MODEL(RangeBearingModel)
 
 /// Discrete-time models named by `--model` (simulated; the filter commands refuse them for now).
 #define KUSHNER_DISCRETE_MODELS(DISCRETE_MODEL) DISCRETE_MODEL(ClarkLinearModel)

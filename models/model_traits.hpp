@@ -44,6 +44,20 @@ struct has_sdc_drift<Model, std::void_t<decltype(std::declval<const Model&>().sd
                                 0.0, std::declval<const Vec<Model::state_dim>&>()))>> : std::true_type {};
 
 template <class Model, class = void>
+struct has_gaussian_observation : std::false_type {};
+template <class Model>
+struct has_gaussian_observation<Model, std::void_t<decltype(std::declval<const Model&>().gaussian_observation(
+                                           0.0, std::declval<const Vec<Model::state_dim>&>(),
+                                           std::declval<const Mat<Model::state_dim, Model::state_dim>&>()))>>
+    : std::true_type {};
+
+template <class Model, class = void>
+struct has_sdc_observation : std::false_type {};
+template <class Model>
+struct has_sdc_observation<Model, std::void_t<decltype(std::declval<const Model&>().sdc_observation(
+                                      0.0, std::declval<const Vec<Model::state_dim>&>()))>> : std::true_type {};
+
+template <class Model, class = void>
 struct declares_linear_observation : std::false_type {};
 template <class Model>
 struct declares_linear_observation<Model, std::enable_if_t<Model::linear_observation>> : std::true_type {};
@@ -77,11 +91,16 @@ struct ModelTraits {
   static constexpr bool sdc = linear || detail::has_sdc_drift<Model>::value;
   /// dx = (f(t, x) + B(t) u) dt: the model has a control input, B = control_input(t) (`kushner control`).
   static constexpr bool controlled = Model::control_dim > 0;
+  /// h(t, x) = C(t, x) x + c0(t): linear, or the model's sdc_observation (seed 001 (5)).
+  static constexpr bool sdc_observation = linear_observation || detail::has_sdc_observation<Model>::value;
+  /// E_N[h], E_N[grad h] in closed form: exact for a linear observation, else the model's gaussian_observation.
+  static constexpr bool closed_form_observation = linear_observation || detail::has_gaussian_observation<Model>::value;
   /// E_N[f] exists for every Gaussian (false for tan: E|tan x| is infinite).
   static constexpr bool gaussian_integrable = !detail::declares_non_integrable_drift<Model>::value;
-  /// E_N[f], E_N[grad f] in closed form: the model's own formulas, or exact Gaussian moments of a polynomial.
+  /// E_N[f], E_N[grad f] (and E_N[h], E_N[grad h]) in closed form: the model's own formulas, or exact Gaussian
+  /// moments of a polynomial.
   static constexpr bool closed_form_expectations =
-      gaussian_integrable && linear_observation && (detail::has_gaussian_drift<Model>::value || polynomial);
+      gaussian_integrable && closed_form_observation && (detail::has_gaussian_drift<Model>::value || polynomial);
 
   static constexpr int power_degree() {
     if constexpr (detail::has_power_polynomial<Model>::value)
@@ -121,6 +140,19 @@ KOKKOS_INLINE_FUNCTION auto drift_quadratic_polynomial(const Model& model, doubl
     poly.a0 = lf.a0;
     poly.a1 = lf.A;
     return poly;
+  }
+}
+
+/// h(t, x) = C(x) x + c0 (seed 001 (5)); for a linear observation C = H, c0 = h(t, 0).
+template <class Model>
+KOKKOS_INLINE_FUNCTION SdcObservation<Model::state_dim, Model::obs_dim> observation_sdc(
+    const Model& model, double t, const Vec<Model::state_dim>& x) {
+  if constexpr (detail::has_sdc_observation<Model>::value) {
+    return model.sdc_observation(t, x);
+  } else {
+    static_assert(ModelTraits<Model>::linear_observation,
+                  "observation_sdc: Model has neither sdc_observation(t, x) nor a linear observation");
+    return {model.observation_jacobian(t, x), model.observation(t, Vec<Model::state_dim>::zero())};
   }
 }
 

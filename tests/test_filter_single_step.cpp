@@ -2,9 +2,13 @@
 // update with dy at (m, P), then Euler prediction at the updated (m', P')), on scalar models where each
 // filter's formulas can be written out: the sine model (EKF, SOF, QLF (6.4)-(6.5), ASRE, KBL), a model with a
 // quadratic observation (the dy-driven covariance terms of EKF-DS and SOF, and QLF's cubature of h), scalar
-// polynomial drifts (POLY3, POLY4, BILIN, MIXED) and the Ornstein-Uhlenbeck model (KB).
+// polynomial drifts (POLY3, POLY4, BILIN, MIXED) and the Ornstein-Uhlenbeck model (KB); and on the models with a
+// nonlinear observation, the cubic sensor (h = x^3) and the pendulum (h = sin x1), where EKF-DS differs from EKF
+// and SOF from SOF-B by the h'' terms of seed 000 Tables 1-2 rows [13] and [9] (and QLF, ASRE, UKF use h too).
 #include "engine/filter_bank.hpp"
+#include "models/cubic_sensor_model.hpp"
 #include "models/ou_model.hpp"
+#include "models/pendulum_model.hpp"
 #include "models/sine_model.hpp"
 
 #include <gtest/gtest.h>
@@ -162,6 +166,121 @@ TEST(FilterSingleStep, QuadraticObservationCurvatureTerms) {
     }
     expect_step(s, m - a * m * dt, (1 - a * dt) * (1 - a * dt) * P + q * q * dt, name);
   }
+}
+
+/// The cubic sensor dx = sigma dw, dy = x^3 dt + r dv: h' = 3 x^2, h'' = 6 x; no drift, so the prediction
+/// only adds sigma^2 dt to P.
+TEST(FilterSingleStep, CubicSensorUsesTheNonlinearObservation) {
+  const CubicSensorModel model;
+  const double sigma = model.sigma, r = model.r;
+  double ekf_P = 0.0, ekf_ds_P = 0.0, sof_P = 0.0, sof_b_P = 0.0;
+  for (const char* name : {"EKF", "EKF-DS", "SOF", "SOF-B", "QLF", "ASRE", "UKF", "KBL"}) {
+    OptionValues settings;
+    settings.set("asre_max_iterations", 2L);
+    const OneStep s = one_step(model, name, settings);
+    const double m0 = s.m0, P0 = s.P0, h = m0 * m0 * m0, H = 3 * m0 * m0, h2 = 6 * m0;
+    const std::string n = name;
+    double m = 0.0, P = 0.0;
+    if (n == "EKF" || n == "EKF-DS") {  // rows [14], [13]
+      const Update u = update(P0, H, h, r, s.dy);
+      m = m0 + u.K * u.innovation;
+      P = P0 - dt * u.K * H * P0 + (n == "EKF-DS" ? 0.5 * P0 * h2 * P0 * u.innovation / u.S : 0.0);
+    } else if (n == "SOF" || n == "SOF-B") {  // rows [9], [12]: h_bar = h + 1/2 h'' P
+      const Update u = update(P0, H, h + 0.5 * h2 * P0, r, s.dy);
+      m = m0 + u.K * u.innovation;
+      P = P0 - dt * u.K * H * P0 + (n == "SOF" ? P0 * h2 * P0 * u.innovation / u.S : 0.0);
+    } else if (n == "QLF") {  // (5.9)-(5.10): E[x^3] = m^3 + 3 m P, E[3 x^2] = 3 (m^2 + P)
+      const Update u = update(P0, 3 * (m0 * m0 + P0), h + 3 * m0 * P0, r, s.dy);
+      m = m0 + u.K * u.innovation;
+      P = P0 - dt * u.K * 3 * (m0 * m0 + P0) * P0;
+    } else if (n == "ASRE") {  // seed 001 (11)-(12) with C(x) = x^2 at m^[i-1] = m(0): h_hat = C m, H = C
+      const double C = m0 * m0;
+      const Update u = update(P0, C, C * m0, r, s.dy);
+      m = m0 + u.K * u.innovation;
+      P = P0 - dt * u.K * C * P0;
+    } else if (n == "UKF") {  // alpha = 1, beta = 0, kappa = 0: sigma points m0 +- sqrt(P0), weights 1/2
+      const double d = std::sqrt(P0), hp = std::pow(m0 + d, 3), hm = std::pow(m0 - d, 3), h_bar = 0.5 * (hp + hm);
+      const double Cxh = 0.5 * d * (hp - hm), Chh = 0.5 * ((hp - h_bar) * (hp - h_bar) + (hm - h_bar) * (hm - h_bar));
+      const double S = r * r + dt * Chh, K = Cxh / S;
+      m = m0 + K * (s.dy - h_bar * dt);
+      P = P0 - dt * K * Cxh;
+    } else {  // KBL: h linearized at 0 is 0, so no update
+      m = m0, P = P0;
+    }
+    expect_step(s, m, P + sigma * sigma * dt, name);
+    if (n == "EKF") ekf_P = s.P;
+    if (n == "EKF-DS") ekf_ds_P = s.P;
+    if (n == "SOF") sof_P = s.P;
+    if (n == "SOF-B") sof_b_P = s.P;
+  }
+  // The h'' terms are of order P^2 h'' (dy - h dt) / r^2, far above rounding: EKF-DS != EKF, SOF != SOF-B.
+  EXPECT_GT(std::abs(ekf_ds_P - ekf_P), 1e-6) << "EKF-DS " << ekf_ds_P << " EKF " << ekf_P;
+  EXPECT_GT(std::abs(sof_P - sof_b_P), 1e-6) << "SOF " << sof_P << " SOF-B " << sof_b_P;
+}
+
+/// One step of filter `name` on a model of any dimension: prior, dy and the result.
+template <class Model>
+struct OneStepN {
+  Vec<Model::state_dim> m0, m;
+  Mat<Model::state_dim, Model::state_dim> P0, P;
+  Vec<Model::obs_dim> dy;
+};
+template <class Model>
+OneStepN<Model> one_step_n(const Model& model, const std::string& name, const OptionValues& settings = {}) {
+  constexpr int n = Model::state_dim;
+  FilterBank<Space, Model> bank(Space(), model, model, 1, 99, {name}, settings);
+  bank.step(0, dt, false);
+  OneStepN<Model> s{model.prior_mean, model.prior_mean, model.prior_cov, model.prior_cov, {}};
+  const auto dy = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bank.truths().observations());
+  for (int l = 0; l < Model::obs_dim; ++l) s.dy[l] = dy(0, l);
+  bank.with_slot(name, [&](const auto& slot) {
+    const auto m = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), slot.m);
+    const auto P = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), slot.P);
+    for (int i = 0; i < n; ++i) s.m[i] = m(0, i);
+    for (int i = 0; i < n; ++i)
+      for (int j = i; j < n; ++j) s.P(i, j) = s.P(j, i) = P(0, packed_index(n, i, j));
+  });
+  return s;
+}
+
+/// The pendulum dx1 = x2 dt, dx2 = -g sin x1 dt + q dw, dy = sin x1 dt + r dv, written out component by
+/// component: H = (cos m1, 0), h'' only in (1, 1): -sin m1; f2'' only in (1, 1): g sin x1.
+TEST(FilterSingleStep, PendulumUsesTheNonlinearObservation) {
+  const PendulumModel model;
+  const double g = model.g, q = model.q, r = model.r;
+  Mat<2, 2> ekf_P, ekf_ds_P, sof_P, sof_b_P;
+  for (const char* name : {"EKF", "EKF-DS", "SOF", "SOF-B"}) {
+    const auto s = one_step_n(model, name);
+    const std::string n = name;
+    const bool second_order = n == "SOF" || n == "SOF-B";
+    const double a = s.m0[0], b = s.m0[1], p11 = s.P0(0, 0), p12 = s.P0(0, 1), p22 = s.P0(1, 1);
+    // Update: K = P H^T / S with P H^T = cos(a) (p11, p12), S = r^2 + dt cos(a)^2 p11.
+    const double c = std::cos(a), S = r * r + dt * c * c * p11;
+    const double h_hat = std::sin(a) - (second_order ? 0.5 * std::sin(a) * p11 : 0.0);
+    const double innovation = s.dy[0] - h_hat * dt, k1 = c * p11 / S, k2 = c * p12 / S;
+    double m1 = a + k1 * innovation, m2 = b + k2 * innovation;
+    double P11 = p11 - dt * c * c * p11 * p11 / S, P12 = p12 - dt * c * c * p11 * p12 / S,
+           P22 = p22 - dt * c * c * p12 * p12 / S;
+    // dy terms: w P Hess(h) P, Hess(h) = -sin(a) e1 e1^T, so P Hess P = -sin(a) (p11, p12)(p11, p12)^T.
+    const double weight = n == "EKF-DS" ? 0.5 : n == "SOF" ? 1.0 : 0.0, w = weight * innovation / S * -std::sin(a);
+    P11 += w * p11 * p11, P12 += w * p11 * p12, P22 += w * p12 * p12;
+    // Prediction at the updated (m, P): J = [[0, 1], [-g cos m1, 0]]; SOF adds 1/2 g sin(m1) P11 to f2.
+    const double f2 = -g * std::sin(m1) + (second_order ? 0.5 * g * std::sin(m1) * P11 : 0.0), j21 = -g * std::cos(m1);
+    const double new_m1 = m1 + m2 * dt, new_m2 = m2 + f2 * dt;
+    // (I + J dt) P (I + J dt)^T + diag(0, q^2) dt
+    const double e11 = 1, e12 = dt, e21 = j21 * dt, e22 = 1;
+    const double A11 = e11 * P11 + e12 * P12, A12 = e11 * P12 + e12 * P22, A21 = e21 * P11 + e22 * P12,
+                 A22 = e21 * P12 + e22 * P22;
+    const double N11 = A11 * e11 + A12 * e12, N12 = A11 * e21 + A12 * e22, N22 = A21 * e21 + A22 * e22 + q * q * dt;
+    EXPECT_NEAR(s.m[0], new_m1, exact * std::abs(new_m1)) << name;
+    EXPECT_NEAR(s.m[1], new_m2, exact * std::abs(new_m2)) << name;
+    EXPECT_NEAR(s.P(0, 0), N11, exact * std::abs(N11)) << name;
+    EXPECT_NEAR(s.P(0, 1), N12, 1e-12 * std::abs(N11)) << name;
+    EXPECT_NEAR(s.P(1, 1), N22, exact * std::abs(N22)) << name;
+    (n == "EKF" ? ekf_P : n == "EKF-DS" ? ekf_ds_P : n == "SOF" ? sof_P : sof_b_P) = s.P;
+  }
+  EXPECT_GT(std::abs(ekf_ds_P(0, 0) - ekf_P(0, 0)), 1e-6) << "EKF-DS = EKF on the pendulum";
+  EXPECT_GT(std::abs(sof_P(0, 0) - sof_b_P(0, 0)), 1e-6) << "SOF = SOF-B on the pendulum";
 }
 
 template <int Degree>

@@ -53,7 +53,8 @@ TEST(ModelDerivatives, JacobiansAndHessiansMatchCentralDifferences) {
       ++checked;
     }
   });
-  EXPECT_EQ(checked, 10);  // ou, sine, cubic-oscillator, linear 1-3, car, car-taylor3, terpolymer, benes
+  EXPECT_EQ(checked, 13);  // ou, sine, cubic-oscillator, linear 1-3, car, car-taylor3, terpolymer, benes,
+                           // cubic-sensor, pendulum, range-bearing
 }
 
 }  // namespace

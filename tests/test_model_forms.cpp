@@ -1,7 +1,8 @@
 // The structured forms each model hands the filters describe the same drift as drift() itself: linear
-// forms, componentwise and bilinear polynomials, SDC factorizations A(x) x + b, linear observations, and the
-// closed-form Gaussian expectations (seed 000 (6.4)-(6.5), (6.14); polynomial moments) against 20-node
-// Gauss-Hermite cubature. Every continuous-time model of the registry is checked for every form it has.
+// forms, componentwise and bilinear polynomials, SDC factorizations A(x) x + b and C(x) x + c0, linear
+// observations, and the closed-form Gaussian expectations of drift and observation (seed 000 (6.4)-(6.5), (6.14);
+// polynomial moments; the cubic sensor's and pendulum's E[h]) against 20-node Gauss-Hermite cubature. Every
+// continuous-time model of the registry is checked for every form it has.
 #include "kernels/filters/gaussian_expectations.hpp"
 #include "models/registry.hpp"
 
@@ -61,6 +62,24 @@ void expect_forms_match_drift(const Model& model) {
       expect_vectors_near(h0 + model.observation_jacobian(t, x) * x, model.observation(t, x), 1e-13,
                           name + " linear observation");
     }
+    if constexpr (detail::has_sdc_observation<Model>::value) {
+      const auto c = observation_sdc(model, t, x);
+      expect_vectors_near(c.C * x + c.c0, model.observation(t, x), 1e-13, name + " C(x) x + c0");
+    }
+    if constexpr (detail::has_gaussian_observation<Model>::value) {
+      const GaussHermiteRule rule = make_gauss_hermite_rule(20);
+      for (double s : {0.01, 0.5}) {
+        const Mat<n, n> P = test_covariance<n>(s);
+        ObservationLinearization<n, Model::obs_dim> cubature;
+        ASSERT_TRUE(cubature_observation(model, t, x, P, rule, cubature));
+        const auto closed = model.gaussian_observation(t, x, P);
+        expect_vectors_near(closed.mean, cubature.h, 1e-11, name + " E[h]");
+        for (int i = 0; i < Model::obs_dim; ++i)
+          for (int j = 0; j < n; ++j)
+            EXPECT_NEAR(closed.jacobian(i, j), cubature.H(i, j), 1e-11 * (1 + std::abs(cubature.H(i, j))))
+                << name << " E[grad h] (" << i << ", " << j << ")";
+      }
+    }
     if constexpr (T::closed_form_expectations && n <= max_cubature_dim) {
       const GaussHermiteRule rule = make_gauss_hermite_rule(20);
       for (double s : {0.01, 0.5}) {
@@ -87,7 +106,8 @@ TEST(ModelForms, EveryFormAModelHasDescribesItsDrift) {
       ++checked;
     }
   });
-  EXPECT_EQ(checked, 10);
+  EXPECT_EQ(checked, 13);  // ou, sine, cubic-oscillator, linear 1-3, car, car-taylor3, terpolymer, benes,
+                           // cubic-sensor, pendulum, range-bearing
 }
 
 TEST(ModelForms, ClosedFormExpectationsDifferFromThePointValues) {  // power: E_N[f] != f(m) for nonlinear f

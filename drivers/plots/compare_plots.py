@@ -3,7 +3,7 @@
 
 usage: compare_plots.py DIR
 
-Reads DIR/summary.json, DIR/timeseries.csv, DIR/trajectories.csv and (1-D models) DIR/density.csv, as written
+Reads DIR/summary.json, DIR/timeseries.csv, DIR/trajectories.csv and DIR/density.csv, as written
 by `kushner compare`, and writes PNG and SVG figures plus DIR/report.md; DIR/reproduction.md (written by
 `kushner reproduce`) goes into the report when present. Without matplotlib only report.md is written (its
 tables, and a line saying why there are no figures) and the exit status is 3. Figures are written through a temporary name and
@@ -13,7 +13,7 @@ renamed, like every kushner output.
                        panel per state component, up to 3); the filters' +-2 sigma bands are in trajectories.csv
   errors.{png,svg}     RMS error to the truth against time, per filter (and to the particle mean, dashed)
   rmse_ref.{png,svg}   bar chart of rmse_ref per filter with +-2 standard-error bars
-  density.{png,svg}    (1-D models) the particle density at chosen times with each filter's Gaussian
+  density.{png,svg}    the particle density of x1 (its marginal) at chosen times with each filter's Gaussian
 """
 import csv
 import json
@@ -124,6 +124,7 @@ def plot_rmse_ref(directory, summary, colors):
 
 
 def plot_density(directory, summary, rows, colors):
+    state_dim = int(summary.get("model", {}).get("state_dim", 1))
     times = sorted({float(r["t"]) for r in rows})
     fig, axes = plt.subplots(1, len(times), figsize=(4 * len(times), 3.4), squeeze=False)
     for ax, t in zip(axes[0], times):
@@ -143,8 +144,8 @@ def plot_density(directory, summary, rows, colors):
             xs, ds = zip(*points)
             ax.plot(xs, ds, color=colors.get(name), lw=1.1, label=name)
         ax.set_title(f"t = {t:g}")
-        ax.set_xlabel("x")
-    axes[0][0].set_ylabel("conditional density")
+        ax.set_xlabel("x" if state_dim == 1 else "x1")
+    axes[0][0].set_ylabel("conditional density" if state_dim == 1 else "conditional density of x1 (marginal)")
     axes[0][0].legend(fontsize=7)
     save(fig, directory, "density")
 

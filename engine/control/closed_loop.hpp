@@ -80,7 +80,7 @@ class ControlLoop {
         using Filter = decltype(slot.filter);
         if (estimator != Filter::name) return;
         found = true;
-        enable_filter_slot(slot, model, members, options, std::get<std::optional<Filter>>(prepared));
+        enable_filter_slot(slot, model, members, options, std::get<std::optional<Filter>>(prepared), seed);
       });
       KUSHNER_REQUIRE(found, "ControlLoop: filter '" << estimator << "' is not supported by model " << Model::name);
       source_ = EstimateSource::bank_filter;

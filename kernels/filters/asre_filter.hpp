@@ -1,6 +1,7 @@
 #pragma once
 // ASRE: the Cimen-Banks filter (seed 001 Theorem 2, (11)-(12)) for a factorization f = A(x) x + b (the
-// known input b of Theorem 3 (ii), needed when f(0) != 0) and a linear observation h = c0 + C x:
+// known input b of Theorem 3 (ii), needed when f(0) != 0) and an observation h = C(x) x + c0 (linear, or
+// factored by the model's sdc_observation, seed 001 (5); C below stands for C(m^[i-1](t))):
 //   iterate i = 0, 1, ...: A_i(t) = A(m^[i-1](t)), G_i(t) = G(m^[i-1](t)), m^[-1](t) = m(0) for all t,
 //   dm^[i] = (A_i m^[i] + b) dt + P^[i] C^T V^{-1} (dy - (c0 + C m^[i]) dt),
 //   dP^[i] = (A_i P^[i] + P^[i] A_i^T + G_i G_i^T - P^[i] C^T V^{-1} C P^[i]) dt,
@@ -30,7 +31,7 @@ namespace kushner {
 template <class Model>
 constexpr const char* asre_unsupported() {
   if (!ModelTraits<Model>::sdc) return "model has no factorization f = A(x) x + b";
-  if (!ModelTraits<Model>::linear_observation) return "observation is not linear";
+  if (!ModelTraits<Model>::sdc_observation) return "observation has no factorization h = C(x) x + c0";
   return nullptr;
 }
 
@@ -178,7 +179,8 @@ struct AsreFilter {
   KOKKOS_INLINE_FUNCTION Status step(const Model& model, int member, const StepInput<p>& in, Vec<n>& m_out,
                                      Mat<n, n>& P_out) const {
     static_assert(unsupported == nullptr,
-                  "AsreFilter: Model must define sdc_drift(t, x) (or linear_form) and a linear observation");
+                  "AsreFilter: Model must define sdc_drift(t, x) (or linear_form) and sdc_observation(t, x) (or a "
+                  "linear observation)");
     const auto mi = Kokkos::subview(m, member, Kokkos::ALL, Kokkos::ALL);
     const auto Pi = Kokkos::subview(P, member, Kokkos::ALL, Kokkos::ALL);
     Vec<n> linearization_point = prior_mean, previous_updated = prior_mean;
@@ -190,9 +192,15 @@ struct AsreFilter {
       for (int i = 0; i < n; ++i)
         for (int j = i; j < n; ++j) Pk(i, j) = Pk(j, i) = Pi(packed_index(n, i, j), it);
       const Vec<n> next_linearization_point = mk;  // m^[it](t): iterate it + 1 linearizes here
+      ObservationLinearization<n, p> obs;
+      if constexpr (ModelTraits<Model>::linear_observation) {
+        obs = observation_linearization(model, in.t, mk);
+      } else {  // (11)-(12): C(m^[i-1]) in the gain and in the innovation C(m^[i-1]) m^[i]
+        const SdcObservation<n, p> c = observation_sdc(model, in.t, linearization_point);
+        obs = ObservationLinearization<n, p>{c.C * mk + c.c0, c.C};
+      }
       Vec<p> weighted_innovation;
-      if (!kalman_update(observation_linearization(model, in.t, mk), in, mk, Pk, weighted_innovation))
-        return Status::not_positive_definite;
+      if (!kalman_update(obs, in, mk, Pk, weighted_innovation)) return Status::not_positive_definite;
       const SdcDrift<n> sdc = drift_sdc(model, in.t, linearization_point);
       euler_predict(
           DriftLinearization<n>{sdc.A * mk + sdc.b, sdc.A, noise_intensity(model.diffusion(in.t, linearization_point))},

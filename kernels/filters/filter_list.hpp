@@ -9,6 +9,7 @@
 #include "kernels/filters/asre_filter.hpp"
 #include "kernels/filters/bilinear_filter.hpp"
 #include "kernels/filters/detchmendy_sridhar_filter.hpp"
+#include "kernels/filters/ensemble_kalman_bucy_filter.hpp"
 #include "kernels/filters/extended_kalman_filter.hpp"
 #include "kernels/filters/filter_protocol.hpp"
 #include "kernels/filters/kalman_bucy_filter.hpp"
@@ -17,6 +18,7 @@
 #include "kernels/filters/polynomial_filter.hpp"
 #include "kernels/filters/quasi_linear_filter.hpp"
 #include "kernels/filters/second_order_filter.hpp"
+#include "kernels/filters/unscented_kalman_filter.hpp"
 
 #include "models/linear_model.hpp"
 
@@ -34,8 +36,10 @@ using AllFilters =
     std::tuple<KalmanBucyFilter<Model, MemSpace>, ExtendedKalmanFilter<Model, MemSpace>,
                DetchmendySridharFilter<Model, MemSpace>, SecondOrderFilter<Model, MemSpace>,
                SchwartzBassFilter<Model, MemSpace>, QuasiLinearFilter<Model, MemSpace>,
-               Polynomial3Filter<Model, MemSpace>, Polynomial4Filter<Model, MemSpace>, BilinearFilter<Model, MemSpace>,
-               MixedFilter<Model, MemSpace>, AsreFilter<Model, MemSpace>, LinearizedKalmanBucyFilter<Model, MemSpace>>;
+               UnscentedKalmanFilter<Model, MemSpace>, Polynomial3Filter<Model, MemSpace>,
+               Polynomial4Filter<Model, MemSpace>, BilinearFilter<Model, MemSpace>, MixedFilter<Model, MemSpace>,
+               AsreFilter<Model, MemSpace>, LinearizedKalmanBucyFilter<Model, MemSpace>,
+               EnsembleKalmanBucyFilter<Model, MemSpace>, StochasticEnsembleKalmanBucyFilter<Model, MemSpace>>;
 
 namespace detail {
 template <class Tuple>
@@ -98,11 +102,23 @@ inline std::vector<std::string> all_filter_names() {
   return names;
 }
 
+/// The names of the filters that draw random numbers (filter_randomized), in report order.
+inline std::vector<std::string> randomized_filter_names() {
+  std::vector<std::string> names;
+  for_each_filter_type<LinearModel<1>, Kokkos::HostSpace>([&](auto* tag) {
+    using Filter = std::remove_pointer_t<decltype(tag)>;
+    if (filter_randomized<Filter>()) names.push_back(Filter::name);
+  });
+  return names;
+}
+
 /// Every filter's options, in report order (they do not depend on the model).
 inline std::vector<OptionSpec> all_filter_options() {
   std::vector<OptionSpec> options;
   for_each_filter_type<LinearModel<1>, Kokkos::HostSpace>([&](auto* tag) {
-    for (auto& o : filter_options<std::remove_pointer_t<decltype(tag)>>()) options.push_back(std::move(o));
+    for (auto& o : filter_options<std::remove_pointer_t<decltype(tag)>>())
+      if (std::none_of(options.begin(), options.end(), [&](const OptionSpec& s) { return s.name == o.name; }))
+        options.push_back(std::move(o));  // a setting two filters share is declared once
   });
   return options;
 }

@@ -19,11 +19,17 @@
 //   KOKKOS_INLINE_FUNCTION void apply_known_input(int member, const Vec<n>& shift) const;  // a filter with means
 //                                                 // of its own besides m (ASRE's iterates) adds a closed loop's
 //                                                 // B u dt to them after its step (kernels/filters/filter_slot.hpp)
+//   static Filter create(const OptionValues&, const Model&, long members, std::uint32_t seed);  // instead of
+//                                                             // the create above: a filter that draws random
+//   static constexpr bool randomized = true;                  // numbers gets the run's seed, and says so
+//
+// Filters may declare the same option (equal OptionSpec): it is one setting, shared.
 #include "core/fields.hpp"
 #include "core/options.hpp"
 #include "models/drift_facts.hpp"
 #include "models/model_traits.hpp"
 
+#include <cstdint>
 #include <optional>
 #include <type_traits>
 #include <utility>
@@ -61,6 +67,19 @@ struct has_known_input<
     Filter, N, std::void_t<decltype(std::declval<const Filter&>().apply_known_input(0, std::declval<const Vec<N>&>()))>>
     : std::true_type {};
 
+template <class Filter, class Model, class = void>
+struct has_seeded_create : std::false_type {};
+template <class Filter, class Model>
+struct has_seeded_create<Filter, Model,
+                         std::void_t<decltype(Filter::create(std::declval<const OptionValues&>(),
+                                                             std::declval<const Model&>(), 0L, std::uint32_t{}))>>
+    : std::true_type {};
+
+template <class Filter, class = void>
+struct is_randomized : std::false_type {};
+template <class Filter>
+struct is_randomized<Filter, std::enable_if_t<Filter::randomized>> : std::true_type {};
+
 template <class Filter, class = void>
 struct has_summary_fields : std::false_type {};
 template <class Filter>
@@ -95,6 +114,21 @@ const char* filter_unsupported(const Model& model) {
     return Filter::unsupported_by(model.drift_facts());
   else
     return nullptr;
+}
+
+/// Filter::create; a randomized filter's create also takes the run's seed.
+template <class Filter, class Model>
+Filter create_filter(const OptionValues& options, const Model& model, long members, std::uint32_t seed) {
+  if constexpr (detail::has_seeded_create<Filter, Model>::value)
+    return Filter::create(options, model, members, seed);
+  else
+    return Filter::create(options, model, members);
+}
+
+/// Whether Filter draws random numbers (a Monte Carlo filter: equal to another only in the limit).
+template <class Filter>
+constexpr bool filter_randomized() {
+  return detail::is_randomized<Filter>::value;
 }
 
 /// How many passes over the horizon Filter's pre-pass takes (0: none).

@@ -92,8 +92,8 @@ struct QuasiLinearFilter {
     ObservationLinearization<n, p> obs;
     if constexpr (ModelTraits<Model>::linear_observation) {
       obs = observation_linearization(model, in.t, m);  // E_N[h] = h(m), E_N[grad h] = H exactly
-    } else if constexpr (has_cubature) {
-      if (!cubature_observation(model, in.t, m, P, rule, obs)) return Status::not_positive_definite;
+    } else if (!expected_observation(model, in.t, m, P, obs)) {
+      return Status::not_positive_definite;
     }
     Vec<p> weighted_innovation;
     if (!kalman_update(obs, in, m, P, weighted_innovation)) return Status::not_positive_definite;
@@ -101,6 +101,20 @@ struct QuasiLinearFilter {
     if (!expected_drift(model, in.t, m, P, g)) return Status::not_positive_definite;
     euler_predict(DriftLinearization<n>{g.mean, g.jacobian, noise_intensity(model.diffusion(in.t, m))}, in.dt, m, P);
     return Status::ok;
+  }
+
+  /// E_N[h], E_N[grad h] of a nonlinear observation: the model's closed form (seed 000 (5.9)-(5.10)) or cubature.
+  KOKKOS_INLINE_FUNCTION bool expected_observation(const Model& model, double t, const Vec<n>& m, const Mat<n, n>& P,
+                                                   ObservationLinearization<n, p>& obs) const {
+    if constexpr (detail::has_gaussian_observation<Model>::value) {
+      if (expectations == Expectations::closed) {
+        const GaussianObservation<n, p> g = model.gaussian_observation(t, m, P);
+        obs = ObservationLinearization<n, p>{g.mean, g.jacobian};
+        return true;
+      }
+    }
+    if constexpr (has_cubature) return cubature_observation(model, t, m, P, rule, obs);
+    return false;  // unreachable: create() accepts only methods the model has
   }
 
   KOKKOS_INLINE_FUNCTION bool expected_drift(const Model& model, double t, const Vec<n>& m, const Mat<n, n>& P,

@@ -1,0 +1,185 @@
+#pragma once
+// EnKBF: the ensemble Kalman-Bucy filter, N ensemble members per bank member (`--enkbf-particles`), each
+// following the model's own dynamics and pulled towards the observations with a gain made from ensemble
+// statistics (Evensen 1994; continuous time: Bergemann and Reich 2012; the forms below as in Taghvaei, de Wiljes,
+// Mehta and Reich 2018, "Kalman filter and its modern extensions for the continuous-time nonlinear filtering
+// problem"):
+//   dX_i = f(X_i) dt + G dW_i + K (dy - h(X_i) dt - R dV_i),         K = P^{xh} V^{-1}    (EnKBF-S: stochastic,
+//                                                                                          perturbed observations)
+//   dX_i = f(X_i) dt + G dW_i + K (dy - 1/2 (h(X_i) + h_bar) dt)                          (EnKBF: deterministic
+//                                                                                          innovation, Bergemann-Reich)
+// with P^{xh}, h_bar the ensemble's covariance of x with h(x) and mean of h(x); W_i, V_i independent Brownian
+// motions per ensemble member. Both variants sample the process noise. The bank reports the ensemble's mean
+// and covariance (divisor N - 1) as m and P.
+// One step of the bank's discretization (kernels/filters/filter_step.hpp): the update with dy uses the ensemble
+// statistics of the step's start, S = V + dt P^{hh}, K = P^{xh} S^{-1} (the discrete ensemble Kalman update of
+// the observation dy with noise V dt), then every member takes its Euler-Maruyama step. On a linear model the
+// stochastic variant's mean and covariance equal the Kalman-Bucy step's in expectation, so as N grows it tends to
+// Kalman-Bucy with Monte Carlo error of order N^{-1/2}; the deterministic one has the same limit up to O(dt) (its
+// half-gain step contracts the spread by (I - dt K H / 2)^2, not I - dt K H).
+// Random numbers: initial ensemble from N(prior mean, prior cov) on Stream::filter_initial, process noise on
+// Stream::filter_noise, observation perturbations on Stream::filter_observation, each keyed by the run's seed with
+// counter {member, ensemble member, step}.
+#include "core/errors.hpp"
+#include "core/linear_algebra.hpp"
+#include "kernels/filters/filter_protocol.hpp"
+#include "kernels/filters/filter_step.hpp"
+#include "kernels/rng.hpp"
+
+#include <Kokkos_Core.hpp>
+
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+namespace kushner {
+
+template <class Model, class MemSpace, bool Stochastic>
+struct EnsembleKalmanBucyBase {
+  static constexpr int n = Model::state_dim, p = Model::obs_dim, q = Model::noise_dim;
+  static constexpr const char* unsupported = nullptr;  // needs only f, G and h
+  static constexpr bool randomized = true;
+
+  int num_particles = 0;
+  std::uint32_t seed = 0;
+  Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace> ensemble;  // (member, ensemble member, i)
+
+  static std::vector<OptionSpec> options() {
+    return {OptionSpec::integer("enkbf_particles", 100, 2, 1 << 20,
+                                "ensemble members per bank member of EnKBF and EnKBF-S")};
+  }
+
+  /// The initial ensemble: num_particles draws from N(prior_mean, prior_cov) per member.
+  static void initialize(EnsembleKalmanBucyBase& f, const Model& model, long members, long particles,
+                         std::uint32_t seed) {
+    f.num_particles = static_cast<int>(particles);
+    f.seed = seed;
+    f.ensemble = decltype(f.ensemble)(Kokkos::view_alloc(Kokkos::WithoutInitializing, "kushner::enkbf_ensemble"),
+                                      members, particles, n);
+    Mat<n, n> L;
+    KUSHNER_REQUIRE(semidefinite_cholesky(model.prior_cov, L, covariance_tolerance) != Definiteness::indefinite,
+                    "EnKBF: prior_cov is not positive semidefinite");
+    auto host = Kokkos::create_mirror_view(f.ensemble);
+    const RngKey key{seed, Stream::filter_initial};
+    for (long member = 0; member < members; ++member)
+      for (long k = 0; k < particles; ++k) {
+        const Vec<n> x = model.prior_mean + L * normal_vector<n>(key, static_cast<std::uint32_t>(member),
+                                                                 static_cast<std::uint32_t>(k), 0);
+        for (int i = 0; i < n; ++i) host(member, k, i) = x[i];
+      }
+    Kokkos::deep_copy(f.ensemble, host);
+  }
+
+  Fields summary_fields() const {
+    return {{"particles", static_cast<long>(num_particles)},
+            {"variant", std::string(Stochastic ? "stochastic" : "deterministic")}};
+  }
+
+  KOKKOS_INLINE_FUNCTION Vec<n> load_member(int member, int k) const {
+    Vec<n> x;
+    for (int i = 0; i < n; ++i) x[i] = ensemble(member, k, i);
+    return x;
+  }
+
+  /// A closed loop's known input B u dt moves every ensemble member alike (its Euler step is x + (f + B u) dt + ...).
+  KOKKOS_INLINE_FUNCTION void apply_known_input(int member, const Vec<n>& shift) const {
+    for (int k = 0; k < num_particles; ++k)
+      for (int i = 0; i < n; ++i) ensemble(member, k, i) += shift[i];
+  }
+
+  KOKKOS_INLINE_FUNCTION Status step(const Model& model, int member, const StepInput<p>& in, Vec<n>& m,
+                                     Mat<n, n>& P) const {
+    const int N = num_particles;
+    const auto step_index = static_cast<std::uint32_t>(in.t / in.dt + 0.5);
+    const auto who = static_cast<std::uint32_t>(member);
+    // Ensemble statistics at the step's start: x_bar, h_bar, P^{xh}, P^{hh} (two passes: means, then spreads).
+    Vec<n> x_bar = Vec<n>::zero();
+    Vec<p> h_bar = Vec<p>::zero();
+    for (int k = 0; k < N; ++k) {
+      const Vec<n> x = load_member(member, k);
+      x_bar += x;
+      h_bar += model.observation(in.t, x);
+    }
+    x_bar = x_bar * (1.0 / N);
+    h_bar = h_bar * (1.0 / N);
+    Mat<n, p> Pxh = Mat<n, p>::zero();
+    Mat<p, p> Phh = Mat<p, p>::zero();
+    for (int k = 0; k < N; ++k) {
+      const Vec<n> x = load_member(member, k);
+      const Vec<p> dh = model.observation(in.t, x) - h_bar;
+      Pxh += outer(x - x_bar, dh);
+      Phh += outer(dh, dh);
+    }
+    Pxh = Pxh * (1.0 / (N - 1));
+    Phh = Phh * (1.0 / (N - 1));
+    const Mat<p, p> S = in.V + Phh * in.dt;
+    Mat<p, p> LS, LV;
+    if (!cholesky(S, LS) || !cholesky(in.V, LV)) return Status::not_positive_definite;
+    Mat<n, p> K;  // P^{xh} S^{-1}, row by row
+    for (int i = 0; i < n; ++i) {
+      Vec<p> row;
+      for (int l = 0; l < p; ++l) row[l] = Pxh(i, l);
+      const Vec<p> k = cholesky_solve(LS, row);
+      for (int l = 0; l < p; ++l) K(i, l) = k[l];
+    }
+    // Update and Euler-Maruyama step of every ensemble member; the new mean and covariance on the way.
+    const double sqrt_dt = math::sqrt(in.dt);
+    const auto u = Model::Control::zero();
+    const RngKey noise_key{seed, Stream::filter_noise}, observation_key{seed, Stream::filter_observation};
+    Vec<n> sum = Vec<n>::zero();
+    for (int k = 0; k < N; ++k) {
+      Vec<n> x = load_member(member, k);
+      const Vec<p> hx = model.observation(in.t, x);
+      Vec<p> innovation;
+      if constexpr (Stochastic) {
+        const Vec<p> dv = normal_vector<p>(observation_key, who, static_cast<std::uint32_t>(k), step_index);
+        innovation = in.dy - hx * in.dt - LV * dv * sqrt_dt;
+      } else {
+        innovation = in.dy - (hx + h_bar) * (0.5 * in.dt);
+      }
+      x += K * innovation;
+      const Vec<q> dw = normal_vector<q>(noise_key, who, static_cast<std::uint32_t>(k), step_index);
+      x += model.drift(in.t, x, u) * in.dt + model.diffusion(in.t, x) * dw * sqrt_dt;
+      for (int i = 0; i < n; ++i) ensemble(member, k, i) = x[i];
+      sum += x;
+    }
+    m = sum * (1.0 / N);
+    Mat<n, n> cov = Mat<n, n>::zero();
+    for (int k = 0; k < N; ++k) {
+      const Vec<n> d = load_member(member, k) - m;
+      cov += outer(d, d);
+    }
+    P = symmetrize(cov * (1.0 / (N - 1)));
+    return Status::ok;
+  }
+};
+
+template <class Model, class MemSpace>
+struct EnsembleKalmanBucyFilter : EnsembleKalmanBucyBase<Model, MemSpace, false> {
+  static constexpr const char* name = "EnKBF";
+  static constexpr const char* description =
+      "ensemble Kalman-Bucy filter, deterministic innovation (Bergemann-Reich), --enkbf-particles members";
+
+  static EnsembleKalmanBucyFilter create(const OptionValues& options, const Model& model, long members,
+                                         std::uint32_t seed) {
+    EnsembleKalmanBucyFilter f;
+    EnsembleKalmanBucyFilter::initialize(f, model, members, options.integer("enkbf_particles"), seed);
+    return f;
+  }
+};
+
+template <class Model, class MemSpace>
+struct StochasticEnsembleKalmanBucyFilter : EnsembleKalmanBucyBase<Model, MemSpace, true> {
+  static constexpr const char* name = "EnKBF-S";
+  static constexpr const char* description =
+      "ensemble Kalman-Bucy filter, perturbed observations (stochastic), --enkbf-particles members";
+
+  static StochasticEnsembleKalmanBucyFilter create(const OptionValues& options, const Model& model, long members,
+                                                   std::uint32_t seed) {
+    StochasticEnsembleKalmanBucyFilter f;
+    StochasticEnsembleKalmanBucyFilter::initialize(f, model, members, options.integer("enkbf_particles"), seed);
+    return f;
+  }
+};
+
+}  // namespace kushner

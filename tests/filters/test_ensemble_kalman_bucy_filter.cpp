@@ -1,0 +1,117 @@
+// EnKBF, EnKBF-S: on a linear model the ensemble filters tend to the Kalman-Bucy filter as the ensemble grows,
+// with Monte Carlo error of order N^{-1/2}. Over M = 256 members the RMS distance of the ensemble mean to the
+// Kalman-Bucy mean after T = 1 is measured at N = 32 and N = 1024; its log-log slope must be -1/2 within five
+// standard errors (each RMS has relative standard error 1/2 SE(mean e^2)/mean e^2 from the members, the slope
+// sqrt(se_32^2 + se_1024^2) / ln 32, which ignores the positive correlation of the two and so overstates it).
+// Power: the same check on an ensemble filter of a wrong model (A off by 0.3) fails, its error stops falling.
+#include "engine/filter_bank.hpp"
+#include "models/linear_model.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <iostream>
+#include <string>
+
+namespace kushner {
+namespace {
+
+using Space = Kokkos::DefaultExecutionSpace;
+constexpr long num_members = 256;
+constexpr long num_steps = 100;
+constexpr double dt = 0.01;
+constexpr std::uint32_t seed = 20261125;
+
+LinearModel<1> linear_1d(double A = -0.7) {
+  LinearModel<1> model;
+  model.a0 = Vec<1>{{0.3}};
+  model.A = Mat<1, 1>{{{A}}};
+  model.c0 = Vec<1>{{0.1}};
+  model.C = Mat<1, 1>{{{2.0}}};
+  model.b = Mat<1, 1>{{{0.8}}};
+  return model;
+}
+
+struct Distance {
+  double rms, log_se;  // RMS over members of m_EnKBF - m_KB, and the standard error of its logarithm
+};
+
+/// EnKBF `name` with `particles` members per bank member, run on `filter_model`, against Kalman-Bucy on the
+/// truths' model, both seeing the same truths and dy.
+Distance distance_to_kalman_bucy(const std::string& name, long particles, const LinearModel<1>& filter_model) {
+  const LinearModel<1> truth = linear_1d();
+  OptionValues settings;
+  settings.set("enkbf_particles", particles);
+  FilterBank<Space, LinearModel<1>> kb(Space(), truth, truth, num_members, seed, {"KB"});
+  FilterBank<Space, LinearModel<1>> en(Space(), truth, filter_model, num_members, seed, {name}, settings);
+  for (long k = 0; k < num_steps; ++k) {
+    kb.step(k, dt, false);
+    en.step(k, dt, false);
+  }
+  double sum = 0.0, sum2 = 0.0;
+  kb.with_slot("KB", [&](const auto& a) {
+    en.with_slot(name, [&](const auto& b) {
+      const auto ma = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), a.m);
+      const auto mb = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), b.m);
+      for (long member = 0; member < num_members; ++member) {
+        const double e2 = (mb(member, 0) - ma(member, 0)) * (mb(member, 0) - ma(member, 0));
+        sum += e2, sum2 += e2 * e2;
+      }
+    });
+  });
+  const double mean = sum / num_members, var = (sum2 / num_members - mean * mean) * num_members / (num_members - 1);
+  return {std::sqrt(mean), 0.5 * std::sqrt(var / num_members) / mean};
+}
+
+struct Slope {
+  double value, standard_error;
+};
+
+Slope convergence_slope(const std::string& name, const LinearModel<1>& filter_model) {
+  const Distance small = distance_to_kalman_bucy(name, 32, filter_model);
+  const Distance large = distance_to_kalman_bucy(name, 1024, filter_model);
+  const double span = std::log(1024.0 / 32.0);
+  std::cout << name << ": RMS |m - m_KB| " << small.rms << " at N = 32, " << large.rms << " at N = 1024\n";
+  return {(std::log(large.rms) - std::log(small.rms)) / span,
+          std::sqrt(small.log_se * small.log_se + large.log_se * large.log_se) / span};
+}
+
+void expect_inverse_square_root_convergence(const std::string& name) {
+  const Slope s = convergence_slope(name, linear_1d());
+  std::cout << name << ": slope " << s.value << " +- " << s.standard_error << "\n";
+  EXPECT_LT(std::abs(s.value + 0.5), 5.0 * s.standard_error)
+      << name << ": slope " << s.value << " +- " << s.standard_error << ", expected -0.5";
+  const Slope wrong = convergence_slope(name, linear_1d(-0.4));  // power: a filter of another model
+  EXPECT_GT(std::abs(wrong.value + 0.5), 5.0 * wrong.standard_error)
+      << name << " on a wrong model: slope " << wrong.value << " +- " << wrong.standard_error;
+}
+
+TEST(EnsembleKalmanBucyFilter, StochasticTendsToKalmanBucyLikeInverseSqrtN) {
+  expect_inverse_square_root_convergence("EnKBF-S");
+}
+
+TEST(EnsembleKalmanBucyFilter, DeterministicTendsToKalmanBucyLikeInverseSqrtN) {
+  expect_inverse_square_root_convergence("EnKBF");
+}
+
+TEST(EnsembleKalmanBucyFilter, SameSeedSameNumbersOtherSeedOthers) {
+  const LinearModel<1> model = linear_1d();
+  OptionValues settings;
+  settings.set("enkbf_particles", 16L);
+  const auto final_means = [&](std::uint32_t s) {
+    FilterBank<Space, LinearModel<1>> bank(Space(), model, model, 8, s, {"EnKBF-S"}, settings);
+    for (long k = 0; k < 10; ++k) bank.step(k, dt, false);
+    Kokkos::View<double**, Kokkos::LayoutLeft, Kokkos::HostSpace> m;
+    bank.with_slot("EnKBF-S",
+                   [&](const auto& slot) { m = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), slot.m); });
+    return m;
+  };
+  const auto a = final_means(3), b = final_means(3), c = final_means(4);
+  for (int member = 0; member < 8; ++member) {
+    EXPECT_EQ(a(member, 0), b(member, 0));
+    EXPECT_NE(a(member, 0), c(member, 0));
+  }
+}
+
+}  // namespace
+}  // namespace kushner
