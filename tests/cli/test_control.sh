@@ -51,6 +51,20 @@ assert a["cost"]["F"] == [[2.0]] and a["cost"]["R"] == [[0.5]]
 print("summary ok: J* =", ref["J"], {n: round(a["controllers"][n]["J"], 4) for n in names})
 PY
 
+# On a linear model every Gaussian filter is Kalman-Bucy, so the known input must reach each filter's own state
+# exactly: LQR@UKF and ASRE@ASRE (its iterates) equal LQG; LQR@EnKBF (its ensemble) runs beside them.
+run_kushner "$work/lin" control --model linear --members 200 --T 1 --dt 1e-2 --seed 2 --no-plots --quiet \
+  --controllers LQG,LQR@UKF,ASRE-C,LQR@EnKBF --cost 'Q=1,0;0,1' --out "$work/lin"
+[ "$rc" -eq 0 ] || fail "control on the linear model failed: $(cat "$work/lin.err")"
+"$python" - "$work/lin/summary.json" <<'PY' || fail "linear-model control checks failed"
+import json, sys
+s = json.load(open(sys.argv[1]))
+c = s["controllers"]
+for name in ("LQR@UKF", "ASRE-C"):
+    assert abs(c[name]["J"] - c["LQG"]["J"]) <= 1e-10 * c["LQG"]["J"], (name, c[name]["J"], c["LQG"]["J"])
+print("linear: LQG", c["LQG"]["J"], "UKF", c["LQR@UKF"]["J"], "ASRE-C", c["ASRE-C"]["J"], "EnKBF", c["LQR@EnKBF"]["J"])
+PY
+
 # Bad input: one line on stderr, exit 2, nothing written.
 bad() {
   local name=$1 expect=$2; shift 2

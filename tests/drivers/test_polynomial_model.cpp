@@ -260,13 +260,14 @@ x0_cov = [[1.0]]
 TEST(PolynomialModel, FileEqualToTheCubicOscillatorGivesItsNumbersBitForBit) {
   const auto file = model_from_file<2>("cubic_oscillator.toml");
   const CubicOscillatorModel builtin;
-  const auto u = Vec<0>::zero();
+  const auto u = Vec<0>::zero();                          // the file model has no control input
+  const auto ub = CubicOscillatorModel::Control::zero();  // the built-in one's, at zero
   for (int point = 0; point < 20; ++point) {
     const Vec<2> x = test_point<2>(point) * (1.0 + point);
-    expect_bitwise_equal(file.drift(0.0, x, u), builtin.drift(0.0, x, u), "drift");
-    expect_bitwise_equal(file.drift_jacobian(0.0, x, u), builtin.drift_jacobian(0.0, x, u), "Jacobian");
+    expect_bitwise_equal(file.drift(0.0, x, u), builtin.drift(0.0, x, ub), "drift");
+    expect_bitwise_equal(file.drift_jacobian(0.0, x, u), builtin.drift_jacobian(0.0, x, ub), "Jacobian");
     for (int k = 0; k < 2; ++k)
-      expect_bitwise_equal(file.drift_hessian(0.0, x, u, k), builtin.drift_hessian(0.0, x, u, k), "Hessian");
+      expect_bitwise_equal(file.drift_hessian(0.0, x, u, k), builtin.drift_hessian(0.0, x, ub, k), "Hessian");
     expect_bitwise_equal(file.sdc_drift(0.0, x).A, builtin.sdc_drift(0.0, x).A, "A(x)");
     expect_bitwise_equal(noise_intensity(file.diffusion(0.0, x)), noise_intensity(builtin.diffusion(0.0, x)), "b b^T");
   }
@@ -280,7 +281,8 @@ TEST(PolynomialModel, FileEqualToTheLinearModelGivesItsNumbersBitForBit) {
   const LinearModel<2> builtin;
   for (int point = 0; point < 20; ++point) {
     const Vec<2> x = test_point<2>(point);
-    expect_bitwise_equal(file.drift(0.0, x, Vec<0>::zero()), builtin.drift(0.0, x, Vec<0>::zero()), "drift");
+    expect_bitwise_equal(file.drift(0.0, x, Vec<0>::zero()), builtin.drift(0.0, x, LinearModel<2>::Control::zero()),
+                         "drift");
     expect_bitwise_equal(file.observation(0.0, x), builtin.observation(0.0, x), "observation");
   }
   expect_bitwise_equal(file.linear_form(0.0).A, builtin.linear_form(0.0).A, "A");
