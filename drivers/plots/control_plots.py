@@ -49,8 +49,9 @@ def plot_paths(plt, directory, summary, series, colors):
                 axes[i][0].plot(t, [columns(r, "member_estimate_")[i] for r in rows], color=colors[name],
                                 linestyle="--", linewidth=0.9)
         for j in range(m):
-            # The control at t acts over [t, t + dt]; the last row's control is never applied.
-            axes[n + j][0].step(t[:-1], [columns(r, "member_control_")[j] for r in rows[:-1]], where="post",
+            # A row's control is the one applied over the step that ends at its time (none at t = 0): drawn
+            # from the previous output time on.
+            axes[n + j][0].step(t[:-1], [columns(r, "member_control_")[j] for r in rows[1:]], where="post",
                                 color=colors[name])
     for i in range(n):
         axes[i][0].set_ylabel(f"x{i}")
