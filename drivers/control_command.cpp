@@ -5,7 +5,6 @@
 
 #include <cstdio>
 #include <string>
-#include <type_traits>
 
 namespace kushner {
 
@@ -16,16 +15,7 @@ int run_control_command(const ControlOptions& options, const RunContext& context
   const TimeGrid grid = make_time_grid(options.run.T, options.run.dt, options.run.output_points);
   const OptionValues settings = filter_option_values(options);
   with_run_model(options.run.model, options.run.model_file, options.run.sets, [&](const auto& model) {
-    using Model = std::decay_t<decltype(model)>;
-    if constexpr (Model::discrete_time) {
-      throw InputError(std::string("--model: '") + Model::name +
-                       "' is a discrete-time model; `kushner control` runs continuous-time loops");
-    } else if constexpr (!ModelTraits<Model>::controlled) {
-      throw InputError(std::string("--model: '") + Model::name +
-                       "' has no control input (controlled models: linear, sine, cubic-oscillator, car, car-taylor3)");
-    } else {
-      run_control_model(model, options, settings, grid, context);
-    }
+    run_control_model(model, options, settings, grid, context, /*own_kokkos=*/true);
   });
   return 0;
 }

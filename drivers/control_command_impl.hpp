@@ -1,9 +1,11 @@
 #pragma once
-// The run behind `kushner control` for one model type, in a header so that `kushner reproduce` runs its control
-// examples through the same code (drivers/reproduce/): select and check the controllers, run the closed loops and
-// the optimal-cost reference, write summary.json, timeseries.csv, the plots and report.md.
+// The run behind `kushner control` for one model type (drivers/control_command.hpp), compiled in the command
+// units; `kushner reproduce` runs its control examples through the same code (drivers/reproduce/): select and
+// check the controllers, run the closed loops and the optimal-cost reference, write summary.json,
+// timeseries.csv, the plots and report.md.
 #include "core/eigen_helpers.hpp"
 #include "drivers/commands.hpp"
+#include "drivers/control_command.hpp"
 #include "drivers/control_options.hpp"
 #include "drivers/csv.hpp"
 #include "drivers/fields_json.hpp"
@@ -247,11 +249,10 @@ inline void print_summary(const nlohmann::json& summary, const std::string& out)
   std::printf("written to %s/\n", out.c_str());
 }
 
-/// The whole run for one model; returns summary.json's content. `own_kokkos`: initialize Kokkos here (after the
-/// checks); false when the caller holds a KokkosSession (`kushner reproduce`).
+/// run_control_model for a model with a control input.
 template <class Model>
-nlohmann::json run_control_model(const Model& model, const ControlOptions& options, const OptionValues& settings,
-                                 const TimeGrid& grid, const RunContext& context, bool own_kokkos = true) {
+nlohmann::json run_controlled_model(const Model& model, const ControlOptions& options, const OptionValues& settings,
+                                    const TimeGrid& grid, const RunContext& context, bool own_kokkos) {
   constexpr int n = Model::state_dim, m = Model::control_dim;
   // Everything is checked before the output directory is opened.
   const std::vector<ControllerSpec> specs = select_controllers(options.controllers, model);
@@ -341,3 +342,29 @@ nlohmann::json run_control_model(const Model& model, const ControlOptions& optio
 }
 
 }  // namespace kushner::control_detail
+
+namespace kushner {
+
+template <class Model>
+nlohmann::json run_control_model(const Model& model, const ControlOptions& options, const OptionValues& settings,
+                                 const TimeGrid& grid, const RunContext& context, bool own_kokkos) {
+  if constexpr (Model::discrete_time) {
+    throw InputError(std::string("--model: '") + Model::name +
+                     "' is a discrete-time model; `kushner control` runs continuous-time loops");
+  } else if constexpr (!ModelTraits<Model>::controlled) {
+    throw InputError(std::string("--model: '") + Model::name +
+                     "' has no control input (controlled models: linear, sine, cubic-oscillator, car, car-taylor3, "
+                     "and a --model-file with a [control] table)");
+  } else {
+    if constexpr (is_polynomial_model<Model>::value) {
+      bool has_input = false;
+      for (int i = 0; i < Model::state_dim; ++i) has_input = has_input || model.B(i, 0) != 0.0;
+      KUSHNER_INPUT_REQUIRE(has_input, "--model-file " << options.run.model_file
+                                                       << ": no control input (add a [control] table with B, the "
+                                                          "input's column, e.g. B = [0.0, 1.0])");
+    }
+    return control_detail::run_controlled_model(model, options, settings, grid, context, own_kokkos);
+  }
+}
+
+}  // namespace kushner

@@ -205,6 +205,13 @@ nlohmann::json run_compare_with_truth(const TruthModel& truth_model, const Model
     if (!recorder.density_csv().empty()) {
       contents.emplace_back("density.csv", csv_comment(context) + recorder.density_csv());
       files.push_back("density.csv");
+      const auto& bimodal = recorder.most_bimodal();
+      summary["density"] = {{"times", density_times},
+                            {"most_bimodal",
+                             {{"member", bimodal.member},
+                              {"t", bimodal.t},
+                              {"score", bimodal.score},
+                              {"scanned_members", bimodal.scanned_members}}}};
     }
     summary["files"] = files;
     contents.emplace_back("summary.json", summary.dump(2) + "\n");

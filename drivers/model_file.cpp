@@ -136,9 +136,102 @@ std::map<std::vector<int>, int> monomial_indices(int n) {
   return index;
 }
 
+/// One polynomial of the file, g_k(x) = c0_k + sum_i c1_ki x_i + sum of monomials of degree 2..max_degree, for
+/// k < rows: the drift (rows = n, a0..a4, [[drift.terms]]) or the observation (rows = p, c0..c3 or C for c1,
+/// [[observation.terms]]). Tensors and terms are summed into one coefficient per monomial.
+struct PolynomialPart {
+  std::string prefix;  // "drift." or "observation."
+  char letter;         // 'a' or 'c': the tensors' names
+  int max_degree;
+  int rows;  // -1: the first tensor found sets it (the observation's p)
+  std::vector<double> constant, linear, monomial;
+};
+
+void read_polynomial(const ModelFileReader& in, const toml::table* table, int n, PolynomialPart& part) {
+  const int num_monomials = polynomial_monomial_count(n);
+  const std::map<std::vector<int>, int> monomial = monomial_indices(n);
+  std::vector<std::vector<double>> tensors(part.max_degree + 1);
+  std::vector<bool> given(part.max_degree + 1, false);
+  for (int degree = 0; degree <= part.max_degree; ++degree) {
+    std::string name = part.letter + std::to_string(degree);
+    if (part.letter == 'c' && degree == 1 && table && table->get("C")) {
+      if (table->get("c1")) in.fail(part.prefix + "C", "give C or c1 (the same matrix), not both");
+      name = "C";
+    }
+    std::vector<int> dims(degree + 1, n);
+    dims[0] = part.rows;
+    if (degree == 0 && part.rows < 0) continue;  // c0 is read once the rows are known
+    given[degree] = in.array(table, part.prefix, name, false, dims, tensors[degree]);
+    if (given[degree]) part.rows = dims[0];
+  }
+  if (part.rows < 0)
+    in.fail(part.prefix + "C", "missing (required: the observation's linear part C, p x n, or one of c1, c2, c3)");
+  if (part.letter == 'c') {  // now that p is known
+    std::vector<int> dims = {part.rows};
+    given[0] = in.array(table, part.prefix, "c0", false, dims, tensors[0]);
+  }
+  part.constant.assign(part.rows, 0.0);
+  part.linear.assign(part.rows * n, 0.0);
+  part.monomial.assign(part.rows * num_monomials, 0.0);
+  // Adds c x_vars[0] ... x_vars[d-1] to g_k.
+  auto add_term = [&](int k, std::vector<int> vars, double c) {
+    std::sort(vars.begin(), vars.end());
+    if (vars.empty())
+      part.constant[k] += c;
+    else if (vars.size() == 1)
+      part.linear[k * n + vars[0]] += c;
+    else
+      part.monomial[k * num_monomials + monomial.at(vars)] += c;
+  };
+  for (int degree = 0; degree <= part.max_degree; ++degree) {
+    if (!given[degree]) continue;
+    const std::vector<double>& values = tensors[degree];
+    for (std::size_t flat = 0; flat < values.size(); ++flat) {
+      std::vector<int> vars(degree);
+      std::size_t rest = flat;
+      for (int r = degree - 1; r >= 0; --r, rest /= n) vars[r] = static_cast<int>(rest % n);
+      add_term(static_cast<int>(rest), vars, values[flat]);
+    }
+  }
+  const std::string terms_key = part.prefix + "terms";
+  if (const toml::node* terms = table ? table->get("terms") : nullptr) {
+    const toml::array* list = terms->as_array();
+    if (list == nullptr || !list->is_array_of_tables())
+      in.fail(terms_key, std::string("expected [[") + terms_key + "]] tables, got " + type_name(*terms));
+    for (std::size_t i = 0; i < list->size(); ++i) {
+      const std::string key = terms_key + "[" + std::to_string(i) + "]";
+      const toml::table& term = *list->get(i)->as_table();
+      in.only_known_keys(term, key + ".", {"component", "powers", "coefficient"});
+      for (const char* required : {"component", "powers", "coefficient"})
+        if (term.get(required) == nullptr) in.fail(key + "." + required, "missing");
+      const long k = in.integer(*term.get("component"), key + ".component");
+      if (k < 1 || k > part.rows)
+        in.fail(key + ".component",
+                "must be in 1 .. " + std::to_string(part.rows) + " (got " + std::to_string(k) + ")");
+      const toml::array* powers = term.get("powers")->as_array();
+      if (powers == nullptr || static_cast<int>(powers->size()) != n)
+        in.fail(key + ".powers", "expected an array of " + std::to_string(n) + " exponents (one per state)");
+      std::vector<int> vars;
+      for (int v = 0; v < n; ++v) {
+        const long e = in.integer(*powers->get(v), key + ".powers[" + std::to_string(v) + "]");
+        if (e < 0) in.fail(key + ".powers[" + std::to_string(v) + "]", "must not be negative");
+        if (e > part.max_degree || static_cast<long>(vars.size()) + e > part.max_degree)
+          in.fail(key + ".powers", "total degree above " + std::to_string(part.max_degree));
+        vars.insert(vars.end(), e, v);
+      }
+      add_term(static_cast<int>(k - 1), vars, in.number(*term.get("coefficient"), key + ".coefficient"));
+    }
+  }
+  for (const auto* coefficients : {&part.constant, &part.linear, &part.monomial})
+    for (double c : *coefficients)
+      if (!std::isfinite(c))
+        in.fail(part.prefix.substr(0, part.prefix.size() - 1), "coefficients overflow when summed");
+}
+
 PolynomialModelSpec read_spec(const toml::table& root, const std::string& path) {
   const ModelFileReader in(path);
-  in.only_known_keys(root, "", {"state_dim", "name", "description", "drift", "diffusion", "observation", "initial"});
+  in.only_known_keys(root, "",
+                     {"state_dim", "name", "description", "drift", "diffusion", "observation", "control", "initial"});
   PolynomialModelSpec spec;
   spec.path = path;
 
@@ -157,60 +250,11 @@ PolynomialModelSpec read_spec(const toml::table& root, const std::string& path) 
   // Drift: the tensors contracted with x, summed into one coefficient per monomial.
   const toml::table* drift = in.table(root, "drift", false);
   if (drift) in.only_known_keys(*drift, "drift.", {"a0", "a1", "a2", "a3", "a4", "terms"});
-  const int num_monomials = polynomial_monomial_count(spec.n);
-  const std::map<std::vector<int>, int> monomial = monomial_indices(spec.n);
-  spec.a0.assign(spec.n, 0.0);
-  spec.a1.assign(spec.n * spec.n, 0.0);
-  spec.monomial.assign(spec.n * num_monomials, 0.0);
-  // Adds c x_vars[0] ... x_vars[d-1] to f_k.
-  auto add_term = [&](int k, std::vector<int> vars, double c) {
-    std::sort(vars.begin(), vars.end());
-    if (vars.empty())
-      spec.a0[k] += c;
-    else if (vars.size() == 1)
-      spec.a1[k * spec.n + vars[0]] += c;
-    else
-      spec.monomial[k * num_monomials + monomial.at(vars)] += c;
-  };
-  for (int degree = 0; degree <= 4; ++degree) {
-    std::vector<int> dims(degree + 1, spec.n);
-    std::vector<double> values;
-    if (!in.array(drift, "drift.", "a" + std::to_string(degree), false, dims, values)) continue;
-    for (std::size_t flat = 0; flat < values.size(); ++flat) {
-      std::vector<int> vars(degree);
-      std::size_t rest = flat;
-      for (int r = degree - 1; r >= 0; --r, rest /= spec.n) vars[r] = static_cast<int>(rest % spec.n);
-      add_term(static_cast<int>(rest), vars, values[flat]);
-    }
-  }
-  if (const toml::node* terms = drift ? drift->get("terms") : nullptr) {
-    const toml::array* list = terms->as_array();
-    if (list == nullptr || !list->is_array_of_tables())
-      in.fail("drift.terms", std::string("expected [[drift.terms]] tables, got ") + type_name(*terms));
-    for (std::size_t i = 0; i < list->size(); ++i) {
-      const std::string key = "drift.terms[" + std::to_string(i) + "]";
-      const toml::table& term = *list->get(i)->as_table();
-      in.only_known_keys(term, key + ".", {"component", "powers", "coefficient"});
-      for (const char* required : {"component", "powers", "coefficient"})
-        if (term.get(required) == nullptr) in.fail(key + "." + required, "missing");
-      const long k = in.integer(*term.get("component"), key + ".component");
-      if (k < 1 || k > spec.n)
-        in.fail(key + ".component", "must be in 1 .. " + std::to_string(spec.n) + " (got " + std::to_string(k) + ")");
-      const toml::array* powers = term.get("powers")->as_array();
-      if (powers == nullptr || static_cast<int>(powers->size()) != spec.n)
-        in.fail(key + ".powers", "expected an array of " + std::to_string(spec.n) + " exponents (one per state)");
-      std::vector<int> vars;
-      for (int v = 0; v < spec.n; ++v) {
-        const long e = in.integer(*powers->get(v), key + ".powers[" + std::to_string(v) + "]");
-        if (e < 0) in.fail(key + ".powers[" + std::to_string(v) + "]", "must not be negative");
-        if (e > 4 || vars.size() + e > 4) in.fail(key + ".powers", "total degree above 4");
-        vars.insert(vars.end(), e, v);
-      }
-      add_term(static_cast<int>(k - 1), vars, in.number(*term.get("coefficient"), key + ".coefficient"));
-    }
-  }
-  for (double c : spec.monomial)
-    if (!std::isfinite(c)) in.fail("drift", "coefficients overflow when summed");
+  PolynomialPart f{"drift.", 'a', 4, spec.n, {}, {}, {}};
+  read_polynomial(in, drift, spec.n, f);
+  spec.a0 = std::move(f.constant);
+  spec.a1 = std::move(f.linear);
+  spec.monomial = std::move(f.monomial);
 
   // Diffusion b (n x q).
   const toml::table* diffusion = in.table(root, "diffusion", true);
@@ -222,18 +266,30 @@ PolynomialModelSpec read_spec(const toml::table& root, const std::string& path) 
     in.fail("diffusion.b", "has " + std::to_string(spec.q) + " columns, at most state_dim = " + std::to_string(spec.n) +
                                " (give an n x n matrix with the same b b^T)");
 
-  // Observation.
+  // Observation: h of degree <= 3, like the drift; p rows (the first tensor given sets p).
   const toml::table* observation = in.table(root, "observation", true);
-  in.only_known_keys(*observation, "observation.", {"c0", "C", "R"});
-  std::vector<int> C_dims = {-1, spec.n};
-  in.array(observation, "observation.", "C", true, C_dims, spec.C);
-  spec.p = C_dims[0];
+  in.only_known_keys(*observation, "observation.", {"c0", "C", "c1", "c2", "c3", "terms", "R"});
+  PolynomialPart h{"observation.", 'c', 3, -1, {}, {}, {}};
+  read_polynomial(in, observation, spec.n, h);
+  spec.p = h.rows;
   if (spec.p > spec.n)
-    in.fail("observation.C", "has " + std::to_string(spec.p) + " rows, at most state_dim = " + std::to_string(spec.n));
+    in.fail("observation", "has " + std::to_string(spec.p) + " rows, at most state_dim = " + std::to_string(spec.n));
+  spec.c0 = std::move(h.constant);
+  spec.C = std::move(h.linear);
+  spec.observation_monomial = std::move(h.monomial);
   std::vector<int> R_dims = {spec.p, spec.p};
   in.array(observation, "observation.", "R", true, R_dims, spec.R);
-  std::vector<int> c0_dims = {spec.p};
-  if (!in.array(observation, "observation.", "c0", false, c0_dims, spec.c0)) spec.c0.assign(spec.p, 0.0);
+
+  // Control input: one column B (n entries, or an n x 1 matrix); absent: no input.
+  if (const toml::table* control = in.table(root, "control", false)) {
+    in.only_known_keys(*control, "control.", {"B"});
+    const toml::node* B = control->get("B");
+    if (B == nullptr) in.fail("control.B", "missing (required: the input's column, n entries)");
+    const toml::array* a = B->as_array();
+    std::vector<int> dims = {spec.n};
+    if (a != nullptr && !a->empty() && a->get(0)->is_array()) dims = {spec.n, 1};
+    in.array(*B, "control.B", dims, spec.B);
+  }
   // Initial laws.
   const toml::table* initial = in.table(root, "initial", true);
   in.only_known_keys(*initial, "initial.", {"x0_mean", "x0_cov", "prior_mean", "prior_cov"});

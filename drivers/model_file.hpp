@@ -51,8 +51,13 @@ PolynomialModel<N> make_polynomial_model(const PolynomialModelSpec& spec, const 
   for (int i = 0; i < spec.p; ++i) {
     model.c0[i] = spec.c0[i];
     for (int j = 0; j < N; ++j) model.C(i, j) = spec.C[i * N + j];
+    for (int t = 0; t < PolynomialModel<N>::num_observation_monomials; ++t)
+      model.observation_coefficient[i][t] = spec.observation_monomial[i * PolynomialModel<N>::num_monomials + t];
     for (int j = 0; j < spec.p; ++j) model.R(i, j) = spec.R[i * spec.p + j];
   }
+  model.observation_degree = model.observed_degree();
+  if (!spec.B.empty())
+    for (int i = 0; i < N; ++i) model.B(i, 0) = spec.B[i];
   // R is the file's p x p block with the identity below it: R R^T is positive definite when the block's is,
   // and the pivot numbers are the block's.
   check_file_covariance(spec, "observation.R: R R^T", model.R * transpose(model.R), /*allow_singular=*/false);
@@ -73,28 +78,36 @@ nlohmann::json polynomial_model_json(const PolynomialModel<N>& model) {
       for (int j = 0; j < cols; ++j) r[i][j] = m(i, j);
     return r;
   };
-  nlohmann::json terms = nlohmann::json::array();
-  for (int t = 0; t < PolynomialModel<N>::num_monomials; ++t) {
-    const Monomial mono = polynomial_monomial(N, t);
-    std::vector<int> powers(N, 0);
-    for (int r = 0; r < mono.degree; ++r) ++powers[mono.var[r]];
-    for (int k = 0; k < N; ++k)
-      if (model.coefficient[k][t] != 0.0)
-        terms.push_back({{"component", k + 1}, {"powers", powers}, {"coefficient", model.coefficient[k][t]}});
-  }
+  // The nonzero monomial coefficients of `rows` components in the file's [[...terms]] form.
+  auto terms = [](const auto& coefficient, int rows) {
+    nlohmann::json list = nlohmann::json::array();
+    constexpr int count = std::extent_v<std::remove_reference_t<decltype(coefficient)>, 1>;
+    for (int t = 0; t < count; ++t) {
+      const Monomial mono = polynomial_monomial(N, t);
+      std::vector<int> powers(N, 0);
+      for (int r = 0; r < mono.degree; ++r) ++powers[mono.var[r]];
+      for (int k = 0; k < rows; ++k)
+        if (coefficient[k][t] != 0.0)
+          list.push_back({{"component", k + 1}, {"powers", powers}, {"coefficient", coefficient[k][t]}});
+    }
+    return list;
+  };
   nlohmann::json j = {{"state_dim", N},
                       {"obs_dim", p},
                       {"noise_dim", q},
                       {"drift",
                        {{"a0", std::vector<double>(model.a0.v, model.a0.v + N)},
                         {"a1", matrix(model.a1, N, N)},
-                        {"terms", terms},
-                        {"degree", model.drift_facts().degree}}},
+                        {"terms", terms(model.coefficient, N)},
+                        {"degree", model.model_facts().drift_degree}}},
                       {"diffusion", {{"b", matrix(model.b, N, q)}}},
                       {"observation",
                        {{"c0", std::vector<double>(model.c0.v, model.c0.v + p)},
                         {"C", matrix(model.C, p, N)},
-                        {"R", matrix(model.R, p, p)}}}};
+                        {"terms", terms(model.observation_coefficient, p)},
+                        {"degree", model.observed_degree()},
+                        {"R", matrix(model.R, p, p)}}},
+                      {"control", {{"B", matrix(model.B, N, 1)}}}};
   if (model.source != nullptr) {
     j["file"] = model.source->path;
     if (*model.source->label) j["label"] = model.source->label;

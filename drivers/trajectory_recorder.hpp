@@ -2,8 +2,11 @@
 // What `kushner compare` shows for a few chosen members, recorded at the run's output times: the truth, each
 // filter's estimate with its +-2 sigma band, the particle mean with its 5-95% band (trajectories.csv); and the
 // particle density of the first state component (its marginal, for a model of several) of the first chosen
-// member against each filter's Gaussian at chosen times (density.csv). Only those members are copied to the host, so it
-// costs little next to the run.
+// member against each filter's Gaussian at chosen times (density.csv, snapshot "time"). Beside those, the most
+// bimodal particle posterior of x1 seen at any output time after 0 among the first `bimodal_scan_members`
+// members (snapshot "most_bimodal", scored by bimodality_score): where a Gaussian filter cannot follow the
+// posterior, whatever the chosen times. Only those members are copied to the host, so it costs little next to
+// the run.
 #include "core/errors.hpp"
 #include "drivers/csv.hpp"
 #include "drivers/run_metadata.hpp"
@@ -27,6 +30,13 @@ class TrajectoryRecorder {
   using MemSpace = typename ExecSpace::memory_space;
   static constexpr int n = Model::state_dim;
   static constexpr int density_bins = 80;
+  static constexpr int bimodal_scan_members = 32;
+
+  /// The most bimodal snapshot found (score 0: none scanned, or every posterior had one mode).
+  struct BimodalSnapshot {
+    double score = 0.0, t = 0.0;
+    long member = -1, scanned_members = 0;
+  };
 
   /// `members`: the members to follow (each below `num_members`); `density_times`: the density
   /// snapshots are taken at the first output time at or after each of them.
@@ -36,8 +46,8 @@ class TrajectoryRecorder {
       KUSHNER_INPUT_REQUIRE(m >= 0 && m < num_members,
                             "--trajectory-members: member " << m << " is not in 0 .. " << num_members - 1);
     std::sort(density_times_.begin(), density_times_.end());
+    if (!density_times_.empty()) bimodal_.scanned_members = std::min<long>(num_members, bimodal_scan_members);
     trajectories_ = "member,t,component,series,estimate,lower,upper\n";
-    density_ = "t,member,x,series,density\n";
   }
 
   template <class TruthModel>
@@ -45,11 +55,15 @@ class TrajectoryRecorder {
                   const std::vector<const ReferenceEstimator<MemSpace>*>& outside) {
     std::vector<int> members(members_.begin(), members_.end());
     if (members.empty()) return;
+    std::vector<int> copied = members;  // the followed members and those scanned for a bimodal posterior
+    for (int m = 0; m < bimodal_.scanned_members; ++m) copied.push_back(m);
+    std::sort(copied.begin(), copied.end());
+    copied.erase(std::unique(copied.begin(), copied.end()), copied.end());
     const ReferenceEstimator<MemSpace>* pf = nullptr;  // the first estimator among `outside` made of particles
-    std::optional<ParticleSnapshot> snapshot;          // its particles of `members`
+    std::optional<ParticleSnapshot> snapshot;          // its particles of `copied`
     for (const auto* e : outside) {
       if (pf) break;
-      snapshot = e->particle_snapshot(members);
+      snapshot = e->particle_snapshot(copied);
       if (snapshot) pf = e;
     }
     const bool density = pf && next_density_ < density_times_.size() && t >= density_times_[next_density_] - 1e-9;
@@ -73,13 +87,27 @@ class TrajectoryRecorder {
     }
     if (density) {
       while (next_density_ < density_times_.size() && t >= density_times_[next_density_] - 1e-9) ++next_density_;
-      add_density(t, members.front(), bank, outside, *pf, *snapshot);
+      density_ += density_rows("time", t, members.front(), bank, outside, *pf, *snapshot);
     }
+    // At t = 0 every posterior is the Gaussian prior.
+    if (pf && t > 0.0)
+      for (int m = 0; m < bimodal_.scanned_members; ++m) {
+        const double score = snapshot->bimodality(m, 0);
+        if (score <= bimodal_.score) continue;
+        bimodal_.score = score;
+        bimodal_.t = t;
+        bimodal_.member = m;
+        bimodal_rows_ = density_rows("most_bimodal", t, m, bank, outside, *pf, *snapshot);
+      }
   }
 
   const std::string& trajectories_csv() const { return trajectories_; }
   /// Empty unless a density snapshot was taken (a run with the particle filter).
-  std::string density_csv() const { return density_taken_ ? density_ : std::string(); }
+  std::string density_csv() const {
+    if (density_.empty() && bimodal_rows_.empty()) return std::string();
+    return "snapshot,t,member,x,series,density\n" + density_ + bimodal_rows_;
+  }
+  const BimodalSnapshot& most_bimodal() const { return bimodal_; }
 
  private:
   template <class View>
@@ -101,19 +129,22 @@ class TrajectoryRecorder {
     }
   }
 
+  /// density.csv's rows of one snapshot: the particle histogram of x1 of `member` at t, each filter's Gaussian
+  /// on the same bins, and the truth.
   template <class TruthModel>
-  void add_density(double t, int member, const FilterBank<ExecSpace, Model, TruthModel>& bank,
-                   const std::vector<const ReferenceEstimator<MemSpace>*>& outside,
-                   const ReferenceEstimator<MemSpace>& pf, const ParticleSnapshot& snapshot) {
-    density_taken_ = true;
+  std::string density_rows(const std::string& kind, double t, int member,
+                           const FilterBank<ExecSpace, Model, TruthModel>& bank,
+                           const std::vector<const ReferenceEstimator<MemSpace>*>& outside,
+                           const ReferenceEstimator<MemSpace>& pf, const ParticleSnapshot& snapshot) {
+    std::string rows;
     // The range holds the particle mass (0.1%-99.9%) with a margin, so that the filters' bells show too.
     const std::vector<double> q = snapshot.quantiles(member, 0, {0.001, 0.999});
     const double margin = 0.25 * std::max(q[1] - q[0], 1e-12);
     const double lo = q[0] - margin, hi = q[1] + margin, width = (hi - lo) / density_bins;
     const std::vector<double> histogram = snapshot.histogram(member, 0, lo, hi, density_bins);
     auto add = [&](const std::string& series, double x, double d) {
-      density_ += format_number(t) + "," + std::to_string(member) + "," + format_number(x) + "," + series + "," +
-                  format_number(d) + "\n";
+      rows += kind + "," + format_number(t) + "," + std::to_string(member) + "," + format_number(x) + "," + series +
+              "," + format_number(d) + "\n";
     };
     for (int b = 0; b < density_bins; ++b) add(pf.name(), lo + (b + 0.5) * width, histogram[b]);
     auto bell = [&](const std::string& name, double mean, double variance) {
@@ -128,13 +159,14 @@ class TrajectoryRecorder {
     for (const auto* e : outside)
       if (e != &pf) bell(e->name(), row(e->mean(), member)(0), row(e->covariance(), member)(0));
     add("truth", row(bank.truths().state(), member)(0), 0.0);
+    return rows;
   }
 
   std::vector<long> members_;
   std::vector<double> density_times_;
   std::size_t next_density_ = 0;
-  bool density_taken_ = false;
-  std::string trajectories_, density_;
+  BimodalSnapshot bimodal_;
+  std::string trajectories_, density_, bimodal_rows_;
 };
 
 }  // namespace kushner

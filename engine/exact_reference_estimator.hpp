@@ -21,7 +21,7 @@ template <class Model>
 const char* exact_filter_unsupported(const Model& model) {
   if (!has_exact_reference<Model>) return "no exact filter, and no grid filter above dimension 2 or for discrete time";
   if constexpr (ModelTraits<Model>::runtime_checked)
-    if (!model.drift_facts().axis_aligned_noise) return "the grid filter needs axis-aligned noise (b b^T diagonal)";
+    if (!model.model_facts().axis_aligned_noise) return "the grid filter needs axis-aligned noise (b b^T diagonal)";
   return nullptr;
 }
 

@@ -17,6 +17,29 @@
 
 namespace kushner {
 
+/// How bimodal a density histogram is: 0 for one mode, else the height of the second mode over the first's (1:
+/// two equal modes). A second mode counts only at least 4 bins from the highest, with the histogram between
+/// them dipping to at most half its height; the histogram is first smoothed with weights (1, 2, 1) / 4 so that a
+/// bin's sampling noise makes no mode.
+inline double bimodality_score(const std::vector<double>& histogram) {
+  const int bins = static_cast<int>(histogram.size());
+  std::vector<double> h(bins, 0.0);
+  for (int b = 0; b < bins; ++b)
+    h[b] = 0.5 * histogram[b] + 0.25 * ((b > 0 ? histogram[b - 1] : 0.0) + (b + 1 < bins ? histogram[b + 1] : 0.0));
+  std::vector<int> peaks;
+  for (int b = 1; b + 1 < bins; ++b)
+    if (h[b] >= h[b - 1] && h[b] > h[b + 1]) peaks.push_back(b);
+  if (peaks.size() < 2) return 0.0;
+  const int top = *std::max_element(peaks.begin(), peaks.end(), [&](int a, int b) { return h[a] < h[b]; });
+  double score = 0.0;
+  for (int b : peaks) {
+    if (std::abs(b - top) < 4) continue;
+    const double dip = *std::min_element(h.begin() + std::min(b, top), h.begin() + std::max(b, top) + 1);
+    if (dip <= 0.5 * h[b]) score = std::max(score, h[b] / h[top]);
+  }
+  return score;
+}
+
 class ParticleSnapshot {
  public:
   template <class ExecSpace, class Model>
@@ -104,6 +127,22 @@ class ParticleSnapshot {
       density[b] += w_(j, c) / total / width;
     }
     return density;
+  }
+
+  /// bimodality_score of component i of member m on `bins` bins over its weighted mean +- 4 standard deviations
+  /// (computed in one pass, without the sort quantiles() needs: cheap enough to scan many members).
+  double bimodality(int member, int i, int bins = 60) const {
+    const int c = column(member, i);
+    double total = 0.0, mean = 0.0, square = 0.0;
+    for (int j = 0; j < particles_; ++j) {
+      total += w_(j, c);
+      mean += w_(j, c) * x_(j, c, i);
+    }
+    mean /= total;
+    for (int j = 0; j < particles_; ++j) square += w_(j, c) * (x_(j, c, i) - mean) * (x_(j, c, i) - mean);
+    const double sd = std::sqrt(square / total);
+    if (!(sd > 0.0)) return 0.0;
+    return bimodality_score(histogram(member, i, mean - 4.0 * sd, mean + 4.0 * sd, bins));
   }
 
  private:

@@ -45,7 +45,7 @@ struct PowerPolynomial {
 };
 
 /// The terms of p up to degree D (all of p when its degree is at most D). Only for a p whose higher
-/// coefficients are known to vanish (a run-time polynomial whose drift_facts() say so).
+/// coefficients are known to vanish (a run-time polynomial whose model_facts() say so).
 template <int D, int N, int Degree>
 KOKKOS_INLINE_FUNCTION PowerPolynomial<N, (D < Degree ? D : Degree)> truncated(const PowerPolynomial<N, Degree>& p) {
   constexpr int degree = D < Degree ? D : Degree;

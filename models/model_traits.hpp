@@ -2,8 +2,8 @@
 // What a model offers the filters, detected at compile time, and the structured drift forms derived from the
 // most specific one a model has (a linear model is also a degree-1 polynomial and its own SDC factorization).
 // Filters read these to decide, at compile time, whether they support a model (kernels/filters/filter_list.hpp).
-#include "models/drift_facts.hpp"
 #include "models/drift_forms.hpp"
+#include "models/model_facts.hpp"
 
 #include <type_traits>
 #include <utility>
@@ -62,12 +62,12 @@ struct declares_linear_observation : std::false_type {};
 template <class Model>
 struct declares_linear_observation<Model, std::enable_if_t<Model::linear_observation>> : std::true_type {};
 
-/// `DriftFacts drift_facts() const`: a model whose structure is known only at run time (a --model-file
+/// `ModelFacts model_facts() const`: a model whose structure is known only at run time (a --model-file
 /// polynomial) states what its coefficients are.
 template <class Model, class = void>
-struct has_drift_facts : std::false_type {};
+struct has_model_facts : std::false_type {};
 template <class Model>
-struct has_drift_facts<Model, std::void_t<decltype(std::declval<const Model&>().drift_facts())>> : std::true_type {};
+struct has_model_facts<Model, std::void_t<decltype(std::declval<const Model&>().model_facts())>> : std::true_type {};
 
 template <class Model, class = void>
 struct declares_non_integrable_drift : std::false_type {};
@@ -77,11 +77,11 @@ struct declares_non_integrable_drift<Model, std::enable_if_t<!Model::drift_gauss
 
 /// Capabilities of a continuous-time model, as the filters see them. For a model with run-time facts
 /// (`runtime_checked`) they say what its type can offer; its forms (linear_form, drift_power_polynomial,
-/// drift_quadratic_polynomial) describe the whole drift only where its drift_facts() allow, which every filter
+/// drift_quadratic_polynomial) describe the whole drift only where its model_facts() allow, which every filter
 /// checks before it runs (kernels/filters/filter_protocol.hpp).
 template <class Model>
 struct ModelTraits {
-  static constexpr bool runtime_checked = detail::has_drift_facts<Model>::value;
+  static constexpr bool runtime_checked = detail::has_model_facts<Model>::value;
   static constexpr bool linear = detail::has_linear_form<Model>::value;
   /// h(t, x) = h(t, 0) + H x, H = observation_jacobian(t, .) constant in x.
   static constexpr bool linear_observation = linear || detail::declares_linear_observation<Model>::value;

@@ -1,8 +1,9 @@
 #pragma once
 // The numbering of the monomials of degree 2..4 that a polynomial model (models/polynomial_model.hpp) keeps one
-// coefficient each for: by degree, then lexicographically in the sorted variable indices (x1^2, x1 x2, x2^2,
-// x1^3, ... for n = 2). Plain C++ without Kokkos, because the model-file parser (models/model_file.cpp) reads it
-// too and is compiled by the host compiler alone in CUDA builds (toml++ does not get through nvcc). Device code
+// coefficient each for (its drift up to degree 4, its observation up to degree 3): by degree, then
+// lexicographically in the sorted variable indices (x1^2, x1 x2, x2^2, x1^3, ... for n = 2). Plain C++ without
+// Kokkos, because the model-file parser (models/model_file.cpp) reads it too and is compiled by the host compiler
+// alone in CUDA builds (toml++ does not get through nvcc). Device code
 // calls these functions only where a constant is required, but nvcc wants them __host__ __device__ all the same.
 #if defined(__CUDACC__)
 #define KUSHNER_CONSTEXPR_FUNCTION __host__ __device__ constexpr
@@ -40,9 +41,11 @@ KUSHNER_CONSTEXPR_FUNCTION Monomial polynomial_monomial(int n, int t) {
   return Monomial{0, {-1, -1, -1, -1}};
 }
 
-/// Number of monomials of degree 2..4 in n variables.
-KUSHNER_CONSTEXPR_FUNCTION int polynomial_monomial_count(int n) {
-  return n * (n + 1) / 2 + n * (n + 1) * (n + 2) / 6 + n * (n + 1) * (n + 2) * (n + 3) / 24;
+/// Number of monomials of degree 2..max_degree (max_degree <= 4) in n variables: the first ones in
+/// polynomial_monomial() order, which numbers them by degree.
+KUSHNER_CONSTEXPR_FUNCTION int polynomial_monomial_count(int n, int max_degree = 4) {
+  return (max_degree >= 2 ? n * (n + 1) / 2 : 0) + (max_degree >= 3 ? n * (n + 1) * (n + 2) / 6 : 0) +
+         (max_degree >= 4 ? n * (n + 1) * (n + 2) * (n + 3) / 24 : 0);
 }
 
 }  // namespace kushner

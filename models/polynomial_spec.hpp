@@ -14,10 +14,14 @@
 //   coefficient = 0.125
 //   [diffusion]
 //   b = [[...], ...]                 # required, n x q (q <= n): dx = f dt + b dw
-//   [observation]                    # dy = (c0 + C x) dt + R dv
-//   C = [[...], ...]                 # required, p x n (p <= n)
+//   [observation]                    # dy = h(x) dt + R dv, h_k = c0[k] + sum_i C[k][i] x_i + ... + c3 (degree <= 3)
+//   C = [[...], ...]                 # p x n (p <= n); also spelled c1
+//   c2, c3                           # optional, p x n x n, p x n x n x n; one of C (c1), c2, c3 is required
+//   [[observation.terms]]            # optional, repeatable, as [[drift.terms]] (component 1..p, degree <= 3)
 //   R = [[...], ...]                 # required, p x p, R R^T positive definite
 //   c0 = [...]                       # optional, p (absent: zero)
+//   [control]                        # optional: dx = (f(x) + B u) dt + b dw, one input (`kushner control`)
+//   B = [...]                        # n entries (or an n x 1 matrix)
 //   [initial]
 //   x0_mean = [...]                  # required, n: the truths' initial law
 //   x0_cov = [[...], ...]            # required, n x n, positive semidefinite
@@ -30,12 +34,13 @@
 namespace kushner {
 
 /// A model file's content, checked: sizes n (state), p (observation rows), q (diffusion columns); matrices
-/// row-major; `monomial` (n x polynomial_monomial_count(n)) holds the coefficients of degree 2..4 in the
-/// order of polynomial_monomial().
+/// row-major; `monomial` (n x polynomial_monomial_count(n)) holds the drift's coefficients of degree 2..4 in the
+/// order of polynomial_monomial(), `observation_monomial` (p x the same count) the observation's (degree 2..3;
+/// the degree-4 entries zero); `B` the control input's column (empty: no [control]).
 struct PolynomialModelSpec {
   std::string path, label, description;
   int n = 0, p = 0, q = 0;
-  std::vector<double> a0, a1, monomial, b, c0, C, R, x0_mean, x0_cov, prior_mean, prior_cov;
+  std::vector<double> a0, a1, monomial, b, c0, C, observation_monomial, R, B, x0_mean, x0_cov, prior_mean, prior_cov;
 };
 
 /// Reads and checks `path`; InputError "path: key: ..." for a file that cannot be read, is not TOML, lacks a

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 namespace kushner {
 namespace {
@@ -39,6 +40,30 @@ TEST(ParticleSnapshot, PriorQuantilesAndHistogramMatchTheGaussianWithinFourStand
   EXPECT_NEAR(0.5 * (h[19] + h[20]), pdf0, 4 * se_bin + 0.02 * pdf0);  // + curvature of the pdf over a bin
   EXPECT_THROW(snap.quantiles(0, 0, {1.5}), InputError);
   EXPECT_THROW(snap.histogram(0, 0, 1.0, 0.0, 3), InputError);
+}
+
+/// A mixture of two Gaussians (weights w, 1 - w; means -2, 2; sd 0.5) on 60 bins over [-4, 4], times 1 + noise.
+std::vector<double> mixture_histogram(double w, double noise = 0.0) {
+  std::vector<double> h(60);
+  auto bell = [](double x, double mean) { return std::exp(-0.5 * (x - mean) * (x - mean) / 0.25); };
+  for (int b = 0; b < 60; ++b) {
+    const double x = -4.0 + (b + 0.5) * 8.0 / 60;
+    h[b] = (w * bell(x, -2.0) + (1 - w) * bell(x, 2.0)) * (1.0 + noise * std::sin(12.9898 * b * b + 78.233));
+  }
+  return h;
+}
+
+TEST(ParticleSnapshot, BimodalityScoreIsTheSecondModesHeightOverTheFirsts) {
+  EXPECT_NEAR(bimodality_score(mixture_histogram(0.5)), 1.0, 1e-12);  // two equal modes
+  EXPECT_NEAR(bimodality_score(mixture_histogram(0.8)), 0.25, 0.01);  // heights 0.2 : 0.8
+  EXPECT_EQ(bimodality_score(mixture_histogram(1.0)), 0.0);           // one Gaussian
+  EXPECT_LT(bimodality_score(mixture_histogram(1.0, 0.1)), 0.02);     // with 10% noise per bin: no mode of note
+  EXPECT_EQ(bimodality_score(std::vector<double>(60, 1.0)), 0.0);     // flat: no dip, no second mode
+  // A Gaussian cloud of 2^14 particles: its sampling noise scores far below the report's threshold 0.25.
+  LinearModel<1> model;
+  ParticleFilterBank<Space, LinearModel<1>> pf(Space(), model, 3, particles, 5);
+  const ParticleSnapshot snap(pf);
+  for (int m = 0; m < 3; ++m) EXPECT_LT(snap.bimodality(m, 0), 0.05) << "member " << m;
 }
 
 TEST(ParticleSnapshot, PosteriorMedianMatchesKalmanMean) {

@@ -13,7 +13,8 @@ renamed, like every kushner output.
                        panel per state component, up to 3); the filters' +-2 sigma bands are in trajectories.csv
   errors.{png,svg}     RMS error to the truth against time, per filter (and to the particle mean, dashed)
   rmse_ref.{png,svg}   bar chart of rmse_ref per filter with +-2 standard-error bars
-  density.{png,svg}    the particle density of x1 (its marginal) at chosen times with each filter's Gaussian
+  density.{png,svg}    the particle density of x1 (its marginal) at chosen times with each filter's Gaussian,
+                       and the most bimodal one the run saw
 """
 import csv
 import json
@@ -125,12 +126,14 @@ def plot_rmse_ref(directory, summary, colors):
 
 def plot_density(directory, summary, rows, colors):
     state_dim = int(summary.get("model", {}).get("state_dim", 1))
-    times = sorted({float(r["t"]) for r in rows})
-    fig, axes = plt.subplots(1, len(times), figsize=(4 * len(times), 3.4), squeeze=False)
-    for ax, t in zip(axes[0], times):
+    # Panels: the snapshots at the chosen times, then the most bimodal posterior the run saw.
+    panels = sorted({(r["snapshot"] != "time", float(r["t"]), r["member"]) for r in rows})
+    fig, axes = plt.subplots(1, len(panels), figsize=(4 * len(panels), 3.4), squeeze=False)
+    bimodal = summary.get("density", {}).get("most_bimodal", {})
+    for ax, (scanned, t, member) in zip(axes[0], panels):
         by_series = defaultdict(list)
         for r in rows:
-            if float(r["t"]) == t:
+            if (r["snapshot"] != "time", float(r["t"]), r["member"]) == (scanned, t, member):
                 by_series[r["series"]].append((float(r["x"]), float(r["density"])))
         pf = by_series.pop("PF", [])
         if pf:
@@ -143,7 +146,11 @@ def plot_density(directory, summary, rows, colors):
                 continue
             xs, ds = zip(*points)
             ax.plot(xs, ds, color=colors.get(name), lw=1.1, label=name)
-        ax.set_title(f"t = {t:g}")
+        if scanned:
+            ax.set_title(f"most bimodal: member {member}, t = {t:g}\n(score {bimodal.get('score', 0):.2f} of "
+                         f"{bimodal.get('scanned_members', '?')} members)", fontsize=9)
+        else:
+            ax.set_title(f"member {member}, t = {t:g}")
         ax.set_xlabel("x" if state_dim == 1 else "x1")
     axes[0][0].set_ylabel("conditional density" if state_dim == 1 else "conditional density of x1 (marginal)")
     axes[0][0].legend(fontsize=7)
@@ -186,6 +193,13 @@ def write_report(directory, summary, figures, no_figures=None):
     if truth:
         lines.append(f"- truths: `{truth['name']}` model, observation noise {truth['observation_noise']}; filters: "
                      f"`{summary['model']['name']}` model")
+    bimodal = summary.get("density", {}).get("most_bimodal")
+    if bimodal and bimodal.get("member", -1) >= 0:
+        verdict = ("bimodal" if bimodal["score"] >= 0.25 else
+                   "no clearly bimodal posterior (a score below 0.25: one mode, or a second one lost in the noise)")
+        lines.append(f"- most bimodal particle posterior of x1 among members 0–{bimodal['scanned_members'] - 1} at "
+                     f"the output times: member {bimodal['member']} at t = {bimodal['t']:g}, score "
+                     f"{bimodal['score']:.2f} (the second mode's height over the first's): {verdict}")
     ref = summary.get("reference")
     if ref:
         if ref.get("kind") == "particle filter":
@@ -223,7 +237,8 @@ def write_report(directory, summary, figures, no_figures=None):
                 "errors": "RMS error over members against time: to the truth (solid), to the " +
                           ("particle" if particle else "reference's") + " mean (dashed).",
                 "rmse_ref": "Approximation error per filter, with ±2 standard-error bars.",
-                "density": "Particle density (histogram) against each filter's Gaussian, one member."}
+                "density": "Particle density (histogram) against each filter's Gaussian: one member at chosen "
+                           "times, and the most bimodal posterior seen (last panel), which no Gaussian can follow."}
     for name in figures:
         lines += [f"![{name}]({name}.png)", "", captions[name], ""]
     tmp = os.path.join(directory, "report.md.tmp")

@@ -120,12 +120,10 @@ ExampleResult reproduce_basin_car_controller(const ReproduceSettings& settings, 
   const OptionValues values = filter_option_values(control);
   control.run.members = 1;
   control.run.out = (out.path() / "control-sine").string();
-  result.summary["runs"]["control-sine"] =
-      control_detail::run_control_model(sine, control, values, grid, context, false);
+  result.summary["runs"]["control-sine"] = run_control_model(sine, control, values, grid, context, false);
   control.run.members = settings.members;
   control.run.out = (out.path() / "control-brownian").string();
-  result.summary["runs"]["control-brownian"] =
-      control_detail::run_control_model(car, control, values, grid, context, false);
+  result.summary["runs"]["control-brownian"] = run_control_model(car, control, values, grid, context, false);
 
   // (2) The laws: ours (as `kushner control` makes them) and Basin's printed ones, u = +q21 m_phi + q22 m_delta
   // with Q(T) = diag(0.1, 0), on Basin's normalization of the cost (the same minimizer: the cost / 10).

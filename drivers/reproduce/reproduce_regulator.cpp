@@ -137,8 +137,7 @@ ExampleResult reproduce_regulator(const RegulatorCase& c, const ReproduceSetting
   control.plots = settings.plots;
   const TimeGrid grid = make_time_grid(settings.T, dt, control.run.output_points);
   ExampleResult result{ReproductionTable(c.example), "", nlohmann::json::object(), {"control"}};
-  const nlohmann::json summary =
-      control_detail::run_control_model(car, control, filter_option_values(control), grid, context, false);
+  const nlohmann::json summary = run_control_model(car, control, filter_option_values(control), grid, context, false);
   result.summary["runs"]["control"] = summary;
   const nlohmann::json& laws = summary["controllers"];
   auto closed_loop = [&](const char* name) {

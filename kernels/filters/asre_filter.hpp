@@ -193,7 +193,8 @@ struct AsreFilter {
         for (int j = i; j < n; ++j) Pk(i, j) = Pk(j, i) = Pi(packed_index(n, i, j), it);
       const Vec<n> next_linearization_point = mk;  // m^[it](t): iterate it + 1 linearizes here
       ObservationLinearization<n, p> obs;
-      if constexpr (ModelTraits<Model>::linear_observation) {
+      // A run-time polynomial's h may have terms of degree 2 and 3: its C(x) x form.
+      if constexpr (ModelTraits<Model>::linear_observation && !ModelTraits<Model>::runtime_checked) {
         obs = observation_linearization(model, in.t, mk);
       } else {  // (11)-(12): C(m^[i-1]) in the gain and in the innovation C(m^[i-1]) m^[i]
         const SdcObservation<n, p> c = observation_sdc(model, in.t, linearization_point);

@@ -24,8 +24,9 @@ struct BilinearFilter {
   static constexpr const char* description = "Basin's optimal filter for a bilinear drift (coefficient tensor a2)";
   static constexpr const char* unsupported = bilinear_filter_unsupported<Model>();
 
-  static const char* unsupported_by(const DriftFacts& f) {
-    return f.degree > 2 ? "drift is not bilinear (degree above 2)" : nullptr;
+  static const char* unsupported_by(const ModelFacts& f) {
+    if (f.drift_degree > 2) return "drift is not bilinear (degree above 2)";
+    return observation_unsupported_by(f);
   }
 
   static BilinearFilter create(const OptionValues&, const Model&, long) { return {}; }

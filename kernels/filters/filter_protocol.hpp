@@ -11,7 +11,7 @@
 //
 //   static std::vector<OptionSpec> options();                 // its settings: name, default, range, help
 //   static std::optional<OptionProblem> check(const OptionValues&);  // a setting this Model cannot use
-//   static const char* unsupported_by(const DriftFacts&);     // run-time: coefficients it cannot run
+//   static const char* unsupported_by(const ModelFacts&);     // run-time: coefficients it cannot run
 //   static constexpr int prepass_passes;                      // passes over the horizon before the run, and
 //   template <class RunAlone>                                 // the pre-pass itself: run_alone(filter) runs the
 //   static Filter prepare(const OptionValues&, const Model&, long members, RunAlone&&);  // truths with it alone
@@ -26,7 +26,7 @@
 // Filters may declare the same option (equal OptionSpec): it is one setting, shared.
 #include "core/fields.hpp"
 #include "core/options.hpp"
-#include "models/drift_facts.hpp"
+#include "models/model_facts.hpp"
 #include "models/model_traits.hpp"
 
 #include <cstdint>
@@ -52,7 +52,7 @@ struct has_option_check<Filter, std::void_t<decltype(Filter::check(std::declval<
 template <class Filter, class = void>
 struct has_runtime_support : std::false_type {};
 template <class Filter>
-struct has_runtime_support<Filter, std::void_t<decltype(Filter::unsupported_by(std::declval<const DriftFacts&>()))>>
+struct has_runtime_support<Filter, std::void_t<decltype(Filter::unsupported_by(std::declval<const ModelFacts&>()))>>
     : std::true_type {};
 
 template <class Filter, class = void>
@@ -97,6 +97,12 @@ std::vector<OptionSpec> filter_options() {
 }
 
 /// A setting Filter cannot use with its model, if any.
+/// For the filters that need a linear observation: a run-time model's observation degree (its type offers
+/// linear_form, which describes its whole observation only where the degree is at most 1).
+inline const char* observation_unsupported_by(const ModelFacts& f) {
+  return f.observation_degree > 1 ? "observation is not linear (the file has terms of degree 2 or more)" : nullptr;
+}
+
 template <class Filter>
 std::optional<OptionProblem> check_filter_options(const OptionValues& values) {
   if constexpr (detail::has_option_check<Filter>::value)
@@ -111,7 +117,7 @@ template <class Filter, class Model>
 const char* filter_unsupported(const Model& model) {
   if (Filter::unsupported != nullptr) return Filter::unsupported;
   if constexpr (ModelTraits<Model>::runtime_checked && detail::has_runtime_support<Filter>::value)
-    return Filter::unsupported_by(model.drift_facts());
+    return Filter::unsupported_by(model.model_facts());
   else
     return nullptr;
 }

@@ -15,8 +15,9 @@ struct KalmanBucyFilter {
   static constexpr const char* description = "Kalman-Bucy (linear models)";
   static constexpr const char* unsupported = ModelTraits<Model>::linear ? nullptr : "model is not linear";
 
-  static const char* unsupported_by(const DriftFacts& f) {
-    return f.degree > 1 ? "drift is not linear (the file has terms of degree 2 or more)" : nullptr;
+  static const char* unsupported_by(const ModelFacts& f) {
+    if (f.drift_degree > 1) return "drift is not linear (the file has terms of degree 2 or more)";
+    return observation_unsupported_by(f);
   }
 
   static KalmanBucyFilter create(const OptionValues&, const Model&, long) { return {}; }

@@ -29,6 +29,8 @@ struct MixedFilter {
       "Basin's mixed filter: polynomial-filter mean, linearized Kalman-Bucy covariance";
   static constexpr const char* unsupported = mixed_filter_unsupported<Model>();
 
+  static const char* unsupported_by(const ModelFacts& f) { return observation_unsupported_by(f); }
+
   static MixedFilter create(const OptionValues&, const Model&, long) { return {}; }
 
   KOKKOS_INLINE_FUNCTION Status step(const Model& model, int, const StepInput<p>& in, Vec<n>& m, Mat<n, n>& P) const {

@@ -29,10 +29,10 @@ constexpr const char* polynomial_filter_unsupported() {
 
 /// What a run-time polynomial's coefficients must satisfy (its type allows any degree up to 4).
 template <int Degree>
-const char* polynomial_filter_unsupported_by(const DriftFacts& f) {
+const char* polynomial_filter_unsupported_by(const ModelFacts& f) {
   if (f.cross_terms) return "drift has cross terms (monomials of two or more variables), not componentwise powers";
-  if (f.degree > Degree) return Degree == 3 ? "drift has degree above 3" : "drift has degree above 4";
-  return nullptr;
+  if (f.drift_degree > Degree) return Degree == 3 ? "drift has degree above 3" : "drift has degree above 4";
+  return observation_unsupported_by(f);
 }
 
 template <class Model, int Degree>
@@ -60,7 +60,7 @@ struct Polynomial3Filter {
   static constexpr const char* description = "Basin's optimal filter for a third-degree polynomial drift";
   static constexpr const char* unsupported = polynomial_filter_unsupported<Model, 3>();
 
-  static const char* unsupported_by(const DriftFacts& f) { return polynomial_filter_unsupported_by<3>(f); }
+  static const char* unsupported_by(const ModelFacts& f) { return polynomial_filter_unsupported_by<3>(f); }
 
   static Polynomial3Filter create(const OptionValues&, const Model&, long) { return {}; }
 
@@ -76,7 +76,7 @@ struct Polynomial4Filter {
   static constexpr const char* description = "Basin's optimal filter for a fourth-degree polynomial drift";
   static constexpr const char* unsupported = polynomial_filter_unsupported<Model, 4>();
 
-  static const char* unsupported_by(const DriftFacts& f) { return polynomial_filter_unsupported_by<4>(f); }
+  static const char* unsupported_by(const ModelFacts& f) { return polynomial_filter_unsupported_by<4>(f); }
 
   static Polynomial4Filter create(const OptionValues&, const Model&, long) { return {}; }
 

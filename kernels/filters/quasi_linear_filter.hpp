@@ -90,7 +90,8 @@ struct QuasiLinearFilter {
   KOKKOS_INLINE_FUNCTION Status step(const Model& model, int, const StepInput<p>& in, Vec<n>& m, Mat<n, n>& P) const {
     static_assert(unsupported == nullptr, "QuasiLinearFilter: Model has no usable Gaussian expectations");
     ObservationLinearization<n, p> obs;
-    if constexpr (ModelTraits<Model>::linear_observation) {
+    // A run-time polynomial's type offers a linear observation, but its h may have terms of degree 2 and 3.
+    if constexpr (ModelTraits<Model>::linear_observation && !ModelTraits<Model>::runtime_checked) {
       obs = observation_linearization(model, in.t, m);  // E_N[h] = h(m), E_N[grad h] = H exactly
     } else if (!expected_observation(model, in.t, m, P, obs)) {
       return Status::not_positive_definite;

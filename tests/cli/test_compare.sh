@@ -45,8 +45,12 @@ assert {r["member"] for r in rows} == {"0", "1", "2"}, {r["member"] for r in row
 for r in rows:
     assert float(r["lower"]) <= float(r["estimate"]) <= float(r["upper"]), r
 dens = list(csv.DictReader(l for l in open(os.path.join(d, "density.csv")) if not l.startswith("#")))
-assert len({r["t"] for r in dens}) == 3, {r["t"] for r in dens}
-pf = [r for r in dens if r["series"] == "PF" and r["t"] == dens[0]["t"]]
+assert len({r["t"] for r in dens if r["snapshot"] == "time"}) == 3, {r["t"] for r in dens}
+bimodal = s["density"]["most_bimodal"]
+shown = {r["member"] for r in dens if r["snapshot"] == "most_bimodal"}
+assert shown == ({str(bimodal["member"])} if bimodal["member"] >= 0 else set()), (shown, bimodal)
+assert -1 <= bimodal["member"] < bimodal["scanned_members"] == 12 and 0 <= bimodal["score"] <= 1, bimodal
+pf = [r for r in dens if r["series"] == "PF" and r["t"] == dens[0]["t"] and r["snapshot"] == "time"]
 width = float(pf[1]["x"]) - float(pf[0]["x"])
 assert abs(sum(float(r["density"]) for r in pf) * width - 1) < 0.01, "PF histogram does not integrate to ~1"
 assert "rmse_ref" in open(os.path.join(d, "report.md")).read()

@@ -157,8 +157,8 @@ TEST(PolynomialModelFile, TensorsAndTermsAreSummedPerMonomial) {
   const PolynomialModel<3> model = make_polynomial_model<3>(spec, nullptr);
   const int x1x2 = 1;  // x1^2, x1 x2, x1 x3, ...
   EXPECT_DOUBLE_EQ(model.coefficient[0][x1x2], 0.2 + 0.1);
-  EXPECT_EQ(model.drift_facts().degree, 4);
-  EXPECT_TRUE(model.drift_facts().cross_terms);
+  EXPECT_EQ(model.model_facts().drift_degree, 4);
+  EXPECT_TRUE(model.model_facts().cross_terms);
   // No prior in the file: the filters start from the truths' law.
   expect_bitwise_equal(model.prior_mean, model.x0_mean, "prior_mean");
   // p = 2 observation rows, run as 3 with a third channel of pure noise.
@@ -173,7 +173,7 @@ TEST(PolynomialModelFile, TensorsAndTermsAreSummedPerMonomial) {
   const double f2 = -0.2 + 0.2 * x1 - 0.8 * x2 + 0.1 * x3 + 0.4 * x1 * x1 + 0.15 * x2 * x3 + 0.3 * x1 * x2 * x3 +
                     0.01 * x3 * x3 * x3 * x3;
   const double f3 = 0.3 + 0.3 * x2 - 1.2 * x3 - 0.25 * x2 * x2 + 0.05 * x3 * x1 - 0.05 * x2 * x2 * x3 * x3;
-  const Vec<3> f = model.drift(0.0, x, Vec<0>::zero());
+  const Vec<3> f = model.drift(0.0, x, PolynomialModel<3>::Control::zero());
   EXPECT_NEAR(f[0], f1, 1e-14);
   EXPECT_NEAR(f[1], f2, 1e-14);
   EXPECT_NEAR(f[2], f3, 1e-14);
@@ -181,7 +181,7 @@ TEST(PolynomialModelFile, TensorsAndTermsAreSummedPerMonomial) {
 
 template <int N>
 void expect_derivatives_and_forms_match(const PolynomialModel<N>& model, bool componentwise, bool quadratic) {
-  const auto u = Vec<0>::zero();
+  const auto u = PolynomialModel<N>::Control::zero();
   const double h = 1e-5;
   for (int point = 0; point < 6; ++point) {
     const Vec<N> x = test_point<N>(point);
@@ -257,11 +257,98 @@ x0_cov = [[1.0]]
   expect_derivatives_and_forms_match(quartic_1d, true, false);
 }
 
+/// A 2-D model whose observation has terms of degree 2 and 3 (tensors c2, c3 and [[observation.terms]]), p = 2.
+const std::string polynomial_observation = R"(
+state_dim = 2
+[drift]
+a1 = [[-1.0, 0.5], [0.0, -0.5]]
+[diffusion]
+b = [[1.0, 0.0], [0.0, 1.0]]
+[observation]
+c0 = [0.1, -0.2]
+C = [[1.0, 0.0], [0.0, 0.5]]
+c2 = [[[0.0, 0.4], [0.0, 0.0]], [[0.0, 0.0], [0.0, -0.3]]]
+c3 = [[[[0.0, 0.0], [0.0, 0.0]], [[0.0, 0.0], [0.0, 0.0]]], [[[0.2, 0.0], [0.0, 0.0]], [[0.0, 0.0], [0.0, 0.0]]]]
+R = [[1.0, 0.0], [0.0, 1.0]]
+[[observation.terms]]
+component = 1
+powers = [1, 2]
+coefficient = -0.25
+[[observation.terms]]
+component = 2
+powers = [0, 2]
+coefficient = 0.1
+[initial]
+x0_mean = [0.0, 0.0]
+x0_cov = [[1.0, 0.0], [0.0, 1.0]]
+)";
+
+TEST(PolynomialModel, ObservationPolynomialMatchesItsDerivativesAndForms) {
+  const auto model = model_from_text<2>(polynomial_observation);
+  EXPECT_EQ(model.observation_degree, 3);
+  EXPECT_EQ(model.model_facts().observation_degree, 3);
+  EXPECT_EQ(model.obs_rows, 2);
+  const double step = 1e-5;
+  const GaussHermiteRule rule = make_gauss_hermite_rule(20);
+  for (int point = 0; point < 6; ++point) {
+    const Vec<2> x = test_point<2>(point);
+    const double x1 = x[0], x2 = x[1];
+    // c2's (0,1) and the terms: h1 = 0.1 + x1 + 0.4 x1 x2 - 0.25 x1 x2^2; h2 = -0.2 + 0.5 x2 - 0.3 x2^2 + 0.2 x1^3
+    // + 0.1 x2^2.
+    const double h1 = 0.1 + x1 + 0.4 * x1 * x2 - 0.25 * x1 * x2 * x2;
+    const double h2 = -0.2 + 0.5 * x2 - 0.2 * x2 * x2 + 0.2 * x1 * x1 * x1;
+    const Vec<2> h = model.observation(0.0, x);
+    EXPECT_NEAR(h[0], h1, 1e-14);
+    EXPECT_NEAR(h[1], h2, 1e-14);
+    const Mat<2, 2> H = model.observation_jacobian(0.0, x);
+    for (int j = 0; j < 2; ++j) {
+      Vec<2> up = x, down = x;
+      up[j] += step;
+      down[j] -= step;
+      const Vec<2> hd = (model.observation(0.0, up) - model.observation(0.0, down)) * (0.5 / step);
+      const Mat<2, 2> Hd = (model.observation_jacobian(0.0, up) - model.observation_jacobian(0.0, down)) * (0.5 / step);
+      for (int k = 0; k < 2; ++k) {
+        EXPECT_NEAR(H(k, j), hd[k], 1e-7 * (1 + std::abs(hd[k]))) << "d h" << k << " / d x" << j;
+        const Mat<2, 2> second = model.observation_hessian(0.0, x, k);
+        for (int i = 0; i < 2; ++i)
+          EXPECT_NEAR(second(i, j), Hd(k, i), 1e-7 * (1 + std::abs(Hd(k, i)))) << "Hessian of h" << k;
+      }
+    }
+    const SdcObservation<2, 2> sdc = model.sdc_observation(0.0, x);
+    const Vec<2> Cx = sdc.C * x + sdc.c0;
+    for (int k = 0; k < 2; ++k) EXPECT_NEAR(Cx[k], h[k], 1e-13 * (1 + std::abs(h[k]))) << "C(x) x + c0";
+    for (double s : {0.01, 0.5}) {
+      const Mat<2, 2> P = test_covariance<2>(s);
+      ObservationLinearization<2, 2> cubature;
+      ASSERT_TRUE(cubature_observation(model, 0.0, x, P, rule, cubature));
+      const GaussianObservation<2, 2> closed = model.gaussian_observation(0.0, x, P);
+      for (int i = 0; i < 2; ++i) {
+        EXPECT_NEAR(closed.mean[i], cubature.h[i], 1e-12 * (1 + std::abs(cubature.h[i]))) << "E[h]";
+        for (int j = 0; j < 2; ++j)
+          EXPECT_NEAR(closed.jacobian(i, j), cubature.H(i, j), 1e-12 * (1 + std::abs(cubature.H(i, j))))
+              << "E[grad h] (" << i << ", " << j << ")";
+      }
+    }
+  }
+}
+
+TEST(PolynomialModel, FileEqualToTheCubicSensorGivesItsObservationBitForBit) {
+  const auto file = model_from_file<1>("cubic_sensor.toml");
+  const CubicSensorModel builtin;
+  for (int point = 0; point < 20; ++point) {
+    const Vec<1> x = test_point<1>(point) * (1.0 + point);
+    expect_bitwise_equal(file.observation(0.0, x), builtin.observation(0.0, x), "h");
+    expect_bitwise_equal(file.observation_jacobian(0.0, x), builtin.observation_jacobian(0.0, x), "h'");
+    expect_bitwise_equal(file.observation_hessian(0.0, x, 0), builtin.observation_hessian(0.0, x, 0), "h''");
+    expect_bitwise_equal(file.sdc_observation(0.0, x).C, builtin.sdc_observation(0.0, x).C, "C(x)");
+  }
+}
+
 TEST(PolynomialModel, FileEqualToTheCubicOscillatorGivesItsNumbersBitForBit) {
   const auto file = model_from_file<2>("cubic_oscillator.toml");
   const CubicOscillatorModel builtin;
-  const auto u = Vec<0>::zero();                          // the file model has no control input
-  const auto ub = CubicOscillatorModel::Control::zero();  // the built-in one's, at zero
+  const auto u = PolynomialModel<2>::Control::zero();
+  const auto ub = CubicOscillatorModel::Control::zero();
   for (int point = 0; point < 20; ++point) {
     const Vec<2> x = test_point<2>(point) * (1.0 + point);
     expect_bitwise_equal(file.drift(0.0, x, u), builtin.drift(0.0, x, ub), "drift");
@@ -281,8 +368,8 @@ TEST(PolynomialModel, FileEqualToTheLinearModelGivesItsNumbersBitForBit) {
   const LinearModel<2> builtin;
   for (int point = 0; point < 20; ++point) {
     const Vec<2> x = test_point<2>(point);
-    expect_bitwise_equal(file.drift(0.0, x, Vec<0>::zero()), builtin.drift(0.0, x, LinearModel<2>::Control::zero()),
-                         "drift");
+    expect_bitwise_equal(file.drift(0.0, x, PolynomialModel<2>::Control::zero()),
+                         builtin.drift(0.0, x, LinearModel<2>::Control::zero()), "drift");
     expect_bitwise_equal(file.observation(0.0, x), builtin.observation(0.0, x), "observation");
   }
   expect_bitwise_equal(file.linear_form(0.0).A, builtin.linear_form(0.0).A, "A");
@@ -336,6 +423,13 @@ TEST(PolynomialModel, FiltersTheCoefficientsRuleOutAreRefusedAtSelection) {
       "1.0]]" +
       minimal_tail.substr(minimal_tail.find("[observation]") - 1));
   EXPECT_EQ(refusal(quartic, "POLY3"), "filter POLY3 does not support model 'polynomial' (drift has degree above 3)");
+  // A polynomial observation: the filters that need a linear one refuse it at selection.
+  const auto observed = model_from_text<2>(polynomial_observation);
+  EXPECT_EQ(select_filters<Cubic>("all", observed), all_but({"KB", "POLY3", "POLY4", "BILIN", "MIXED"}));
+  for (const char* name : {"KB", "POLY3", "POLY4", "BILIN", "MIXED"})
+    EXPECT_EQ(refusal(observed, name), std::string("filter ") + name +
+                                           " does not support model 'polynomial' (observation is not linear (the "
+                                           "file has terms of degree 2 or more))");
   EXPECT_EQ(refusal(quartic, "POLY4"), "");
   EXPECT_EQ(refusal(quartic, "EXACT"),
             "filter EXACT does not support model 'polynomial' (the grid filter needs axis-aligned noise (b b^T "
@@ -382,7 +476,7 @@ TEST(PolynomialModelFile, BadFilesNameTheFileAndTheKey) {
   EXPECT_EQ(parse_error("state_dim = 2.0\n" + minimal_tail), "m.toml: state_dim: expected an integer, got a number");
   EXPECT_EQ(parse_error("state_dim = 2\nstates = 3\n" + minimal_tail),
             "m.toml: states: unknown key (known here: state_dim, name, description, drift, diffusion, observation, "
-            "initial)");
+            "control, initial)");
   EXPECT_EQ(parse_error("state_dim = 2\n[drift]\na5 = [1.0, 2.0]\n" + minimal_tail),
             "m.toml: drift.a5: unknown key (known here: a0, a1, a2, a3, a4, terms)");
   EXPECT_EQ(parse_error("state_dim = 2\n[drift]\na2 = [[1.0, 2.0], [3.0, 4.0]]\n" + minimal_tail),
@@ -398,6 +492,30 @@ TEST(PolynomialModelFile, BadFilesNameTheFileAndTheKey) {
   const std::string no_R = "state_dim = 2\n" + minimal_tail.substr(0, minimal_tail.find("R = ")) +
                            minimal_tail.substr(minimal_tail.find("[initial]"));
   EXPECT_EQ(parse_error(no_R), "m.toml: observation.R: missing (required: a 2x2 array)");
+  // The observation's polynomial and the control input.
+  const std::string head =
+      "state_dim = 2\n[diffusion]\nb = [[1.0, 0.0], [0.0, 1.0]]\n[initial]\nx0_mean = [0.0, 0.0]\n"
+      "x0_cov = [[1.0, 0.0], [0.0, 1.0]]\n[observation]\nR = [[1.0]]\n";
+  EXPECT_EQ(parse_error(head),
+            "m.toml: observation.C: missing (required: the observation's linear part C, p x n, or "
+            "one of c1, c2, c3)");
+  EXPECT_EQ(parse_error(head + "C = [[1.0, 0.0]]\nc1 = [[1.0, 0.0]]\n"),
+            "m.toml: observation.C: give C or c1 (the same matrix), not both");
+  EXPECT_EQ(parse_error(head + "c2 = [[[0.0, 1.0], [0.0, 0.0]]]\nc3 = [[[[1.0]]]]\n"),
+            "m.toml: observation.c3: expected a 1x2x2x2 array, but observation.c3[0] has 1 entry");
+  EXPECT_EQ(parse_error(head + "c2 = [[[0.0, 1.0], [0.0, 0.0]]]\n"), "");  // p = 1 from c2, no linear part
+  EXPECT_EQ(parse_error(head + "C = [[1.0, 0.0]]\n[[observation.terms]]\ncomponent = 1\npowers = [2, 2]\n"
+                               "coefficient = 1.0\n"),
+            "m.toml: observation.terms[0].powers: total degree above 3");
+  EXPECT_EQ(parse_error(head + "C = [[1.0, 0.0]]\n[[observation.terms]]\ncomponent = 2\npowers = [2, 0]\n"
+                               "coefficient = 1.0\n"),
+            "m.toml: observation.terms[0].component: must be in 1 .. 1 (got 2)");
+  EXPECT_EQ(parse_error(head + "C = [[1.0, 0.0]]\n[control]\nB = [1.0]\n"),
+            "m.toml: control.B: expected a 2 array, but it has 1 entry");
+  EXPECT_EQ(parse_error(head + "C = [[1.0, 0.0]]\n[control]\nB = [[1.0, 0.0], [0.0, 1.0]]\n"),
+            "m.toml: control.B: expected a 2x1 array, but control.B[0] has 2 entries");
+  EXPECT_EQ(parse_error(head + "C = [[1.0, 0.0]]\n[control]\nu = [1.0, 0.0]\n"),
+            "m.toml: control.u: unknown key (known here: B)");
   EXPECT_EQ(parse_error("state_dim = 2\n" + minimal_tail.substr(0, minimal_tail.find("[initial]"))),
             "m.toml: initial: missing (required table [initial])");
   EXPECT_EQ(parse_error("state_dim = 1\n" + minimal_tail),

@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Where CI's compile time goes: builds the tree in a fresh directory with a launcher that times every
+# compiler call, then prints the translation units by CPU seconds (user + sys), slowest first, and the total.
+# CI is bound by total CPU seconds on 2 cores, so that total (not the wall time on a big machine) is the
+# figure to cut.
+#   perf/compile_profile.sh BUILD_DIR [cmake configure args...]   (JOBS=<n>, default nproc; TARGET=<one target>)
+set -euo pipefail
+here=$(cd "$(dirname "$0")/.." && pwd)
+build=${1:?usage: perf/compile_profile.sh BUILD_DIR [cmake args...]}
+shift
+mkdir -p "$build"
+build=$(cd "$build" && pwd)
+log=$build/compile_times.tsv
+launcher=$build/time_compile.sh
+cat >"$launcher" <<'SH'
+#!/usr/bin/env bash
+# Runs one compiler call under /usr/bin/time (else timed by the clock); appends "cpu_seconds<TAB>output" to $KUSHNER_COMPILE_LOG.
+out=unknown
+prev=
+for a in "$@"; do [ "$prev" = "-o" ] && out=$a; prev=$a; done
+if [ -x /usr/bin/time ]; then
+  t=$(mktemp)
+  /usr/bin/time -f "%U %S" -o "$t" "$@"
+  rc=$?
+  awk -v o="$out" '{printf "%.1f\t%s\n", $1 + $2, o}' "$t" >>"$KUSHNER_COMPILE_LOG"
+  rm -f "$t"
+else  # wall seconds: CPU seconds too while the build has a core per job
+  s=$(date +%s.%N)
+  "$@"
+  rc=$?
+  awk -v a="$s" -v b="$(date +%s.%N)" -v o="$out" 'BEGIN {printf "%.1f\t%s\n", b - a, o}' >>"$KUSHNER_COMPILE_LOG"
+fi
+exit $rc
+SH
+chmod +x "$launcher"
+: >"$log"
+export KUSHNER_COMPILE_LOG=$log
+cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER_LAUNCHER="$launcher" "$@" >/dev/null
+start=$(date +%s)
+cmake --build "$build" -j "${JOBS:-$(nproc)}" ${TARGET:+--target $TARGET} >"$build/build.log" 2>&1 || { tail -30 "$build/build.log"; exit 1; }
+echo "wall: $(( $(date +%s) - start )) s with ${JOBS:-$(nproc)} jobs"
+sort -t$'\t' -k1,1 -rn "$log" | sed "s|$build/||" | head -${TOP:-40}
+awk -F'\t' '{s += $1} END {printf "total: %.0f CPU seconds in %d compiler calls\n", s, NR}' "$log"
