@@ -14,7 +14,9 @@ namespace kushner {
 /// What Model (and, for a --model-file polynomial, its coefficients) offers --filters.
 template <class Model>
 EstimatorTable estimator_table(const Model& model) {
-  EstimatorTable table{Model::name, {}, {particle_filter_name, particle_filter_unsupported<Model>()},
+  EstimatorTable table{Model::name,
+                       {},
+                       {particle_filter_name, particle_filter_unsupported<Model>()},
                        {exact_filter_name, exact_filter_unsupported(model)}};
   for (const FilterSupport& f : filter_support(model)) table.bank.push_back({f.name, f.unsupported});
   return table;

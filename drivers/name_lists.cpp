@@ -21,7 +21,8 @@ std::vector<std::string> names_of(const std::vector<NameAvailability>& entries) 
 }
 
 const NameAvailability* find(const std::vector<NameAvailability>& entries, const std::string& name) {
-  const auto it = std::find_if(entries.begin(), entries.end(), [&](const NameAvailability& e) { return e.name == name; });
+  const auto it =
+      std::find_if(entries.begin(), entries.end(), [&](const NameAvailability& e) { return e.name == name; });
   return it == entries.end() ? nullptr : &*it;
 }
 
@@ -78,9 +79,9 @@ std::vector<std::string> select_estimator_names(const std::string& list, const E
       all = true;
     } else if (current == table.particle.name || current == table.exact.name) {
       const NameAvailability& reference = current == table.particle.name ? table.particle : table.exact;
-      KUSHNER_INPUT_REQUIRE(reference.unsupported == nullptr, "filter " << reference.name
-                                                                        << " does not support model '" << table.model
-                                                                        << "' (" << reference.unsupported << ")");
+      KUSHNER_INPUT_REQUIRE(reference.unsupported == nullptr, "filter " << reference.name << " does not support model '"
+                                                                        << table.model << "' (" << reference.unsupported
+                                                                        << ")");
       (current == table.particle.name ? particle : exact) = true;
     } else {
       bank_list += (bank_list.empty() ? "" : ",") + current;

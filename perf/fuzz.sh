@@ -2,7 +2,7 @@
 # Fuzzes the parsers (tests/fuzz/): each target for RUNS executions with libFuzzer, AddressSanitizer and
 # UndefinedBehaviorSanitizer, starting from its seed corpus; prints executions, seconds and the outcome per target.
 #   perf/fuzz.sh [RUNS] [TARGET...]        RUNS: default 1000000; TARGETs: default all
-# Env: FUZZ_BUILD (default build-fuzz; built with clang++-14 when it holds no kushner_fuzz), FUZZ_PARALLEL=1 runs
+# Env: FUZZ_SECONDS stops a target after that long (its count then tells how far it got), FUZZ_BUILD (default build-fuzz; built with clang++-14 when it holds no kushner_fuzz), FUZZ_PARALLEL=1 runs
 # the targets side by side, FUZZ_OUT (default $FUZZ_BUILD/fuzz-out) receives the logs, the grown corpora (the
 # committed seeds stay as they are) and any crashing input, which belongs in tests/fuzz/regressions/<target>/.
 # Exit 1 when any target crashed, hung, leaked or broke a sanitizer rule.
@@ -27,7 +27,7 @@ fuzz_one() {
   local start=$SECONDS rc=0
   # -timeout: an input slower than 10 s is a hang; -rss_limit_mb: more than 2 GB is a memory blow-up.
   KUSHNER_FUZZ_TARGET=$target "$build/kushner_fuzz" -runs="$runs" -timeout=10 -rss_limit_mb=2048 -max_len=4096 \
-    -print_final_stats=1 -artifact_prefix="$out/$target-" "$out/$target" "$root/tests/fuzz/corpus/$target" \
+    -max_total_time="${FUZZ_SECONDS:-0}" -print_final_stats=1 -artifact_prefix="$out/$target-" "$out/$target" "$root/tests/fuzz/corpus/$target" \
     >"$out/$target.log" 2>&1 || rc=$?
   local executed
   executed=$(sed -n 's/^stat::number_of_executed_units: *//p' "$out/$target.log" | tail -1)

@@ -1,8 +1,8 @@
 // `--config FILE` for `kushner simulate`: an accepted file becomes `--key=value` arguments naming only the
 // subcommand's own options, and those arguments go through the same command-line parse and checks as typed ones
 // (CLI11 and validate_run_options may refuse them, never crash on them).
-#include "core/errors.hpp"
 #include "drivers/config_file.hpp"
+#include "core/errors.hpp"
 #include "drivers/run_options.hpp"
 #include "tests/fuzz/fuzz_check.hpp"
 #include "tests/fuzz/fuzz_targets.hpp"

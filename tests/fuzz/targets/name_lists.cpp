@@ -1,7 +1,7 @@
 // `--filters` and `--controllers` against one model's table: an accepted list names only what the model
 // supports, each once, filters in report order. The first byte picks the option, the rest is the list.
-#include "core/errors.hpp"
 #include "drivers/name_lists.hpp"
+#include "core/errors.hpp"
 #include "tests/fuzz/fuzz_check.hpp"
 #include "tests/fuzz/fuzz_targets.hpp"
 
@@ -50,7 +50,7 @@ void check_filters(const std::string& list) {
     const std::size_t index = static_cast<std::size_t>(at - order.begin());
     FUZZ_CHECK(i == 0 || index > last, "selected filters out of report order or twice");
     last = index;
-    const char* why = index < table.bank.size() ? table.bank[index].unsupported
+    const char* why = index < table.bank.size()         ? table.bank[index].unsupported
                       : names[i] == table.particle.name ? table.particle.unsupported
                                                         : table.exact.unsupported;
     FUZZ_CHECK(why == nullptr, "a selected filter the model does not support");
