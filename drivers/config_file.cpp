@@ -3,14 +3,17 @@
 #include "core/errors.hpp"
 
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 
 namespace kushner {
 
-std::vector<std::string> config_file_arguments(const std::string& path, const CLI::App& subcommand) {
-  KUSHNER_INPUT_REQUIRE(std::filesystem::is_regular_file(path), "--config: cannot read '" << path << "'");
+std::vector<std::string> config_arguments(const std::string& text, const std::string& path,
+                                          const CLI::App& subcommand) {
   std::vector<CLI::ConfigItem> items;
   try {
-    items = CLI::ConfigTOML().from_file(path);
+    std::istringstream in(text);
+    items = CLI::ConfigTOML().from_config(in);
   } catch (const CLI::Error& e) {
     throw InputError(path + ": " + e.what());
   }
@@ -31,6 +34,15 @@ std::vector<std::string> config_file_arguments(const std::string& path, const CL
     }
   }
   return args;
+}
+
+std::vector<std::string> config_file_arguments(const std::string& path, const CLI::App& subcommand) {
+  KUSHNER_INPUT_REQUIRE(std::filesystem::is_regular_file(path), "--config: cannot read '" << path << "'");
+  std::ifstream file(path, std::ios::binary);
+  std::ostringstream text;
+  text << file.rdbuf();
+  KUSHNER_INPUT_REQUIRE(file.good() || file.eof(), "--config: cannot read '" << path << "'");
+  return config_arguments(text.str(), path, subcommand);
 }
 
 }  // namespace kushner

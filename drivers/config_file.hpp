@@ -9,6 +9,9 @@
 
 namespace kushner {
 
+/// Arguments equivalent to the config file text `text` (read from `path`, named in errors) for `subcommand`.
+std::vector<std::string> config_arguments(const std::string& text, const std::string& path, const CLI::App& subcommand);
+
 /// Arguments equivalent to the config file at `path` for `subcommand`. InputError (naming the file) when it
 /// cannot be read, does not parse, or holds a key that is not an option of `subcommand`.
 std::vector<std::string> config_file_arguments(const std::string& path, const CLI::App& subcommand);

@@ -10,6 +10,7 @@
 #include "drivers/csv.hpp"
 #include "drivers/fields_json.hpp"
 #include "drivers/memory_check.hpp"
+#include "drivers/name_lists.hpp"
 #include "drivers/output_directory.hpp"
 #include "drivers/plots.hpp"
 #include "drivers/progress.hpp"
@@ -33,27 +34,6 @@
 
 namespace kushner::control_detail {
 
-inline std::vector<std::string> split_list(const std::string& list, const char* option) {
-  std::vector<std::string> items;
-  std::string current;
-  for (std::size_t i = 0; i <= list.size(); ++i) {
-    if (i == list.size() || list[i] == ',') {
-      KUSHNER_INPUT_REQUIRE(!current.empty(), option << ": empty name in '" << list << "'");
-      items.push_back(current);
-      current.clear();
-    } else if (list[i] != ' ') {
-      current += list[i];
-    }
-  }
-  return items;
-}
-
-inline std::string known_laws() {
-  std::string known;
-  for (const auto& law : law_list()) known += (known.empty() ? "" : ", ") + law.name;
-  return known;
-}
-
 /// The estimators a controller of Model can use: the state, the filters the model supports, the particle filter.
 template <class Model>
 std::vector<std::string> known_estimators(const Model& model) {
@@ -64,44 +44,14 @@ std::vector<std::string> known_estimators(const Model& model) {
 }
 
 /// --controllers as specs; one InputError line for an unknown law or estimator, a law the model cannot use, or a
-/// controller named twice.
+/// controller named twice (drivers/name_lists.hpp).
 template <class Model>
 std::vector<ControllerSpec> select_controllers(const std::string& list, const Model& model) {
+  ControllerTable table{Model::name, controller_aliases(), {}, known_estimators(model), {}};
+  for (const LawInfo& law : law_list()) table.laws.push_back({law.name, law_unsupported<Model>(law.name)});
+  for (const FilterSupport& f : filter_support(model)) table.bank.push_back({f.name, f.unsupported});
   std::vector<ControllerSpec> specs;
-  const std::vector<std::string> estimators = known_estimators(model);
-  for (const std::string& item : split_list(list, "--controllers")) {
-    std::string expanded = item;
-    for (const auto& [alias, meaning] : controller_aliases())
-      if (item == alias) expanded = meaning;
-    const std::size_t at = expanded.find('@');
-    KUSHNER_INPUT_REQUIRE(
-        at != std::string::npos && at > 0 && at + 1 < expanded.size(),
-        "--controllers: '" << item << "' is not LAW@ESTIMATOR or an alias (see `kushner controllers`)");
-    ControllerSpec spec{item, expanded.substr(0, at), expanded.substr(at + 1)};
-    const auto laws = law_list();
-    KUSHNER_INPUT_REQUIRE(
-        std::any_of(laws.begin(), laws.end(), [&](const LawInfo& l) { return l.name == spec.law; }),
-        "--controllers: " << item << ": unknown law '" << spec.law << "' (known: " << known_laws() << ")");
-    const char* why = law_unsupported<Model>(spec.law);
-    KUSHNER_INPUT_REQUIRE(why == nullptr, "--controllers: " << item << ": law " << spec.law << " cannot control model '"
-                                                            << Model::name << "' (" << (why ? why : "") << ")");
-    if (std::find(estimators.begin(), estimators.end(), spec.estimator) == estimators.end()) {
-      std::string known;
-      for (const auto& e : estimators) known += (known.empty() ? "" : ", ") + e;
-      const std::vector<FilterSupport> support = filter_support(model);
-      const auto filter = std::find_if(support.begin(), support.end(),
-                                       [&](const FilterSupport& f) { return f.name == spec.estimator; });
-      if (filter != support.end() && filter->unsupported != nullptr)
-        throw InputError("--controllers: " + item + ": estimator " + spec.estimator + " does not support model '" +
-                         Model::name + "' (" + filter->unsupported + ")");
-      throw InputError("--controllers: " + item + ": unknown estimator '" + spec.estimator + "' (known for '" +
-                       Model::name + "': " + known + ")");
-    }
-    for (const auto& other : specs)
-      KUSHNER_INPUT_REQUIRE(other.name != spec.name, "--controllers: " << item << " is named twice");
-    specs.push_back(spec);
-  }
-  KUSHNER_INPUT_REQUIRE(!specs.empty(), "--controllers: empty list");
+  for (const ControllerName& c : select_controller_names(list, table)) specs.push_back({c.name, c.law, c.estimator});
   return specs;
 }
 

@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <csignal>
 #include <iostream>
 #include <memory>
 #include <new>
@@ -158,6 +159,9 @@ std::string allocation_failure(const std::string& message) {
 }  // namespace kushner
 
 int main(int argc, char** argv) {
+  // A file-size limit (ulimit -f) would kill the process with SIGXFSZ mid-write, leaving a .tmp file; ignored,
+  // the write fails with EFBIG instead and OutputDirectory reports it like a full disk.
+  std::signal(SIGXFSZ, SIG_IGN);
   try {
     return kushner::run(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,6 +1,7 @@
 #include "models/polynomial_spec.hpp"
 
 #include "core/errors.hpp"
+#include "drivers/toml_characters.hpp"
 #include "models/polynomial_monomials.hpp"
 
 #include <toml++/toml.h>
@@ -304,6 +305,7 @@ PolynomialModelSpec read_spec(const toml::table& root, const std::string& path) 
 }  // namespace
 
 PolynomialModelSpec parse_polynomial_model(const std::string& text, const std::string& path) {
+  check_toml_characters(text, path);  // before toml++ sees it: drivers/toml_characters.hpp
   toml::table root;
   try {
     root = toml::parse(text, path);

@@ -1,7 +1,10 @@
-#include "models/parameters.hpp"
+#include "models/parameter_value.hpp"
+
+#include "core/errors.hpp"
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdlib>
 
 namespace kushner {
@@ -83,8 +86,9 @@ ParameterValue parse_parameter_value(const std::string& key, const std::string& 
 
 std::pair<std::string, std::string> split_assignment(const std::string& assignment) {
   const auto eq = assignment.find('=');
-  KUSHNER_INPUT_REQUIRE(eq != std::string::npos && eq > 0, "--set: expected key=value, got '" << assignment << "'");
-  return {strip(assignment.substr(0, eq)), assignment.substr(eq + 1)};
+  const std::string key = eq == std::string::npos ? "" : strip(assignment.substr(0, eq));
+  KUSHNER_INPUT_REQUIRE(!key.empty(), "--set: expected key=value, got '" << assignment << "'");
+  return {key, assignment.substr(eq + 1)};
 }
 
 }  // namespace kushner

@@ -4,6 +4,7 @@
 // v(name, field, description) for double, Vec<N> and Mat<R, C> fields; every visitor below serves all models.
 #include "core/errors.hpp"
 #include "core/small_matrix.hpp"
+#include "models/parameter_value.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -14,17 +15,6 @@
 #include <vector>
 
 namespace kushner {
-
-/// A parsed value: a scalar "0.5", a vector "1,2" or "[1, 2]", a matrix "1,0;0,1" or "[[1, 0], [0, 1]]".
-struct ParameterValue {
-  int rows = 0, cols = 0;
-  std::vector<double> values;  // row-major
-};
-
-ParameterValue parse_parameter_value(const std::string& key, const std::string& text);
-
-/// "key=value" -> (key, value); InputError when there is no '=' or an empty key.
-std::pair<std::string, std::string> split_assignment(const std::string& assignment);
 
 /// Applies one key=value to the field named key; `found` tells whether the model has such a field.
 class ParameterSetter {

@@ -21,8 +21,6 @@ extern const EmbeddedPaperValues embedded_paper_values[];
 extern const int num_embedded_paper_values;
 }  // namespace detail
 
-namespace {
-
 /// Splits one CSV line into fields; double quotes protect commas ("" is a quote).
 std::vector<std::string> split_csv_line(const std::string& line) {
   std::vector<std::string> fields(1);
@@ -48,6 +46,8 @@ std::vector<std::string> split_csv_line(const std::string& line) {
   }
   return fields;
 }
+
+namespace {
 
 std::string csv_field(const std::string& s) {
   if (s.find_first_of(",\"\n") == std::string::npos) return s;
@@ -80,27 +80,33 @@ std::vector<std::string> paper_value_examples() {
   return names;
 }
 
-std::vector<PaperValue> paper_values(const std::string& example) {
-  for (int i = 0; i < detail::num_embedded_paper_values; ++i) {
-    if (example != detail::embedded_paper_values[i].example) continue;
-    std::istringstream in(detail::embedded_paper_values[i].csv);
-    std::vector<PaperValue> values;
-    std::string line;
-    bool header = true;
-    while (std::getline(in, line)) {
-      if (line.empty() || line[0] == '#') continue;
-      const std::vector<std::string> f = split_csv_line(line);
-      KUSHNER_REQUIRE(f.size() == 4, "paper values of " << example << ": expected 4 fields in '" << line << "'");
-      if (header) {
-        KUSHNER_REQUIRE(f[0] == "key" && f[1] == "quantity" && f[2] == "paper" && f[3] == "source",
-                        "paper values of " << example << ": header '" << line << "'");
-        header = false;
-        continue;
-      }
-      values.push_back({f[0], f[1], f[2], f[3]});
+std::vector<PaperValue> parse_paper_values(const std::string& csv, const std::string& example) {
+  std::istringstream in(csv);
+  std::vector<PaperValue> values;
+  std::string line;
+  bool header = true;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    const std::vector<std::string> f = split_csv_line(line);
+    KUSHNER_REQUIRE(f.size() == 4, "paper values of " << example << ": expected 4 fields in '" << line << "'");
+    if (header) {
+      KUSHNER_REQUIRE(f[0] == "key" && f[1] == "quantity" && f[2] == "paper" && f[3] == "source",
+                      "paper values of " << example << ": header '" << line << "'");
+      header = false;
+      continue;
     }
-    return values;
+    // Rows are filled by key (ReproductionTable::add): a second row of one key could never be.
+    for (const PaperValue& v : values)
+      KUSHNER_REQUIRE(v.key != f[0], "paper values of " << example << ": key '" << f[0] << "' twice");
+    values.push_back({f[0], f[1], f[2], f[3]});
   }
+  return values;
+}
+
+std::vector<PaperValue> paper_values(const std::string& example) {
+  for (int i = 0; i < detail::num_embedded_paper_values; ++i)
+    if (example == detail::embedded_paper_values[i].example)
+      return parse_paper_values(detail::embedded_paper_values[i].csv, example);
   KUSHNER_REQUIRE(false, "no paper values for example '" << example << "'");
   return {};
 }
@@ -124,8 +130,11 @@ std::string format_ours(double value, double standard_error, const char* plus_mi
   return buffer;
 }
 
-ReproductionTable::ReproductionTable(std::string example) : example_(std::move(example)) {
-  for (const PaperValue& v : paper_values(example_)) rows_.push_back({v});
+ReproductionTable::ReproductionTable(std::string example) : ReproductionTable(example, paper_values(example)) {}
+
+ReproductionTable::ReproductionTable(std::string example, const std::vector<PaperValue>& values)
+    : example_(std::move(example)) {
+  for (const PaperValue& v : values) rows_.push_back({v});
   filled_.assign(rows_.size(), false);
 }
 

@@ -15,6 +15,13 @@ struct PaperValue {
   std::string key, quantity, paper, source;
 };
 
+/// One line of CSV as fields; double quotes protect commas ("" is a quote).
+std::vector<std::string> split_csv_line(const std::string& line);
+
+/// The rows of a data file's text `csv` (a header key,quantity,paper,source; '#' lines and empty lines skipped;
+/// double quotes protect commas; keys unique); KUSHNER_REQUIRE on a malformed one, naming `example`.
+std::vector<PaperValue> parse_paper_values(const std::string& csv, const std::string& example);
+
 /// The data file of `example` ("basin-car-filter", ...), parsed; InputError-free (the files are ours):
 /// KUSHNER_REQUIRE on a malformed one.
 std::vector<PaperValue> paper_values(const std::string& example);
@@ -44,6 +51,8 @@ struct ReproductionRow {
 class ReproductionTable {
  public:
   explicit ReproductionTable(std::string example);
+  /// The table of rows `values` (the data file's, or a test's).
+  ReproductionTable(std::string example, const std::vector<PaperValue>& values);
 
   /// Our number for the data file's row `key` (KUSHNER_REQUIRE that it exists and is not filled yet); the
   /// verdict follows from the paper's value and reproduction_tolerance.

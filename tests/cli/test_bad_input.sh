@@ -40,6 +40,22 @@ expect_refused "--set x0_cov: '-inf' is not finite" simulate --set x0_cov=-inf -
 expect_refused "--dt: must be positive (got nan)" simulate --dt nan --out "$fresh"
 expect_refused "--T: must be positive (got inf)" simulate --T inf --out "$fresh"
 expect_refused "--ess-threshold: must be in [0, 1] (got nan)" filter --ess-threshold nan --out "$fresh"
+expect_refused "--set Q: 'nan' is not finite" control --cost Q=nan --out "$fresh"
+expect_refused "--ukf-alpha: must be positive (got nan)" filter --filters UKF --ukf-alpha nan --out "$fresh"
+expect_refused "--asre-tolerance: must be positive (got inf)" filter --filters ASRE --asre-tolerance inf --out "$fresh"
+printf 'T = 1\ndt = nan\n' >"$work/nan.toml"
+expect_refused "--dt: must be positive (got nan)" simulate --config "$work/nan.toml" --out "$fresh"
+sed 's/^x0_mean = .*/x0_mean = [nan, 0.0]/' "$(dirname "$0")/../../models/examples/linear2.toml" >"$work/nan-model.toml"
+expect_refused "nan-model.toml: initial.x0_mean[0]: not finite" simulate --model-file "$work/nan-model.toml" --out "$fresh"
+# Found by fuzzing (tests/fuzz/regressions/): a list of blanks selected no filter and ran; a blank key; a model
+# file with a code point that sends toml++ 3.3.0 into undefined behaviour.
+expect_refused "--filters: empty name in ' '" filter --filters ' ' --out "$fresh"
+expect_refused "--filters: empty name in 'PF, '" filter --filters 'PF, ' --out "$fresh"
+expect_refused "--controllers: empty name in 'LQR@state,'" control --controllers 'LQR@state,' --out "$fresh"
+expect_refused "--set: expected key=value, got ' =1'" simulate --set ' =1' --out "$fresh"
+printf 'state_dim = 1\n\xcf\x83 = 1\n' >"$work/sigma.toml"
+expect_refused "sigma.toml: line 2, column 1: U+03C3 is a character the TOML reader of this build (toml++ 3.3.0) mishandles" \
+  simulate --model-file "$work/sigma.toml" --out "$fresh"
 # Sizes whose product overflows the index type (int): members, members x particles, steps.
 expect_refused "--members: at most 2147483647 (got 4000000000)" simulate --members 4000000000 --out "$fresh"
 expect_refused "--particles: --members x --particles must be at most 2147483647, the particle filter's index range (got 100000 x 30000 = 3000000000)" \

@@ -3,7 +3,7 @@
 # directory and too little memory each give one line "kushner: error: ..." on stderr and exit 2, leaving results
 # already written as they were and no .tmp files; filters and particle filters pushed to divergence finish the
 # run and are counted. (Bad input: test_bad_input.sh.) The disk cases need root (mount); they are skipped
-# otherwise, and say so.
+# otherwise, and say so; a file-size limit (ulimit -f) stands in for a full disk for any user.
 set -euo pipefail
 kushner=$1
 source "$(dirname "$0")/lib.sh"
@@ -66,6 +66,22 @@ if [ "$(id -u)" -eq 0 ] && mkdir "$work/disk" && mount -t tmpfs -o size=64k tmpf
 else
   echo "skip: the full-disk and read-only cases need root to mount a tmpfs"
 fi
+
+# A file-size limit (ulimit -f, any user; the full disk's stand-in where no tmpfs can be mounted): the write fails
+# with "File too large" instead of SIGXFSZ killing the run mid-file and leaving a .tmp behind.
+"$kushner" simulate "${small[@]}" --out "$work/limited"
+before=$(digest "$work/limited")
+set +e
+(ulimit -f 1 && exec "$kushner" simulate --members 5 --T 1 --dt 0.01 --output-points 101 --quiet \
+  --out "$work/limited") >"$work/r.out" 2>"$work/r.err"
+rc=$?
+set -e
+[ "$rc" -eq 2 ] || fail "file-size limit: exit $rc (want 2): $(cat "$work/r.err")"
+[ "$(wc -l <"$work/r.err")" -eq 1 ] || fail "file-size limit: stderr is not one line: $(cat "$work/r.err")"
+grep -qF "kushner: error: --out: cannot write '$work/limited/timeseries.csv': File too large (files already there are unchanged)" \
+  "$work/r.err" || fail "file-size limit: $(cat "$work/r.err")"
+[ "$before" = "$(digest "$work/limited")" ] || fail "a file-size limit changed the results already written"
+echo "ok: $(cat "$work/r.err")"
 
 # A directory the user may not write (as root, run as nobody: root writes through permissions).
 as_nobody=(setpriv --reuid=65534 --regid=65534 --clear-groups)
