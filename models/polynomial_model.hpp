@@ -117,9 +117,8 @@ struct PolynomialModel : InitialLaw<N> {
   static constexpr bool linear_observation = true;
   static constexpr const char* name = "polynomial";
   static constexpr const char* description =
-      "polynomial model from a file (--model-file): dx = (f(x) + B u) dt + b dw, f of degree <= 4, dy = h(x) dt + R "
-      "dv, "
-      "h of degree <= 3";
+      "polynomial model from a file (--model-file): dx = (f(x) + B u) dt + b dw, f of degree <= 4, "
+      "dy = h(x) dt + R dv, h of degree <= 3";
   static constexpr int num_monomials = detail::monomial_count<N, 4>;
   static constexpr int num_observation_monomials = detail::monomial_count<N, 3>;
   using Control = Vec<control_dim>;

@@ -1,4 +1,5 @@
-// `--model-file`: a file the reader accepts describes a model of the sizes it states, every coefficient finite.
+// `--model-file`: a file the reader accepts describes a model of the sizes it states, every coefficient finite, the
+// observation's polynomial of degree <= 3.
 #include "core/errors.hpp"
 #include "models/polynomial_monomials.hpp"
 #include "models/polynomial_spec.hpp"
@@ -33,6 +34,13 @@ int model_file(const std::uint8_t* data, std::size_t size) {
     check_block(spec.monomial, n * polynomial_monomial_count(spec.n), "drift monomials");
     check_block(spec.b, n * q, "diffusion.b");
     check_block(spec.C, p * n, "observation.C");
+    check_block(spec.observation_monomial, p * polynomial_monomial_count(spec.n), "observation monomials");
+    for (std::size_t k = 0; k < p; ++k)
+      for (int t = polynomial_monomial_count(spec.n, 3); t < polynomial_monomial_count(spec.n); ++t)
+        FUZZ_CHECK(spec.observation_monomial[k * polynomial_monomial_count(spec.n) + t] == 0.0,
+                   "an observation term of degree 4");
+    FUZZ_CHECK(spec.B.empty() || spec.B.size() == n, "control.B not n entries");
+    check_block(spec.B, spec.B.size(), "control.B");
     check_block(spec.R, p * p, "observation.R");
     check_block(spec.c0, p, "observation.c0");
     check_block(spec.x0_mean, n, "initial.x0_mean");
