@@ -4,10 +4,12 @@
 // particle density of the first state component (its marginal, for a model of several) of the first chosen
 // member against each filter's Gaussian at chosen times (density.csv). Only those members are copied to the host, so it
 // costs little next to the run.
+#include "core/collectives.hpp"
 #include "core/errors.hpp"
 #include "drivers/csv.hpp"
 #include "drivers/run_metadata.hpp"
 #include "engine/filter_bank.hpp"
+#include "engine/member_share.hpp"
 #include "engine/reference_estimator.hpp"
 #include "kernels/host_copy.hpp"
 
@@ -29,9 +31,10 @@ class TrajectoryRecorder {
   static constexpr int density_bins = 80;
 
   /// `members`: the members to follow (each below `num_members`); `density_times`: the density
-  /// snapshots are taken at the first output time at or after each of them.
+  /// snapshots are taken at the first output time at or after each of them. In a run over MPI ranks every
+  /// rank records the same text: the rank that holds a member writes its rows and sends them to the others.
   TrajectoryRecorder(const std::vector<long>& members, long num_members, std::vector<double> density_times)
-      : members_(members), density_times_(std::move(density_times)) {
+      : members_(members), density_times_(std::move(density_times)), share_(member_share(num_members)) {
     for (long m : members_)
       KUSHNER_INPUT_REQUIRE(m >= 0 && m < num_members,
                             "--trajectory-members: member " << m << " is not in 0 .. " << num_members - 1);
@@ -43,37 +46,30 @@ class TrajectoryRecorder {
   template <class TruthModel>
   void operator()(double t, const FilterBank<ExecSpace, Model, TruthModel>& bank,
                   const std::vector<const ReferenceEstimator<MemSpace>*>& outside) {
-    std::vector<int> members(members_.begin(), members_.end());
-    if (members.empty()) return;
+    if (members_.empty()) return;
+    std::vector<int> local;  // the chosen members this rank holds, as indices into its bank
+    for (long m : members_)
+      if (share_.holds(m)) local.push_back(static_cast<int>(m - share_.first));
     const ReferenceEstimator<MemSpace>* pf = nullptr;  // the first estimator among `outside` made of particles
-    std::optional<ParticleSnapshot> snapshot;          // its particles of `members`
+    std::optional<ParticleSnapshot> snapshot;          // its particles of `local`
     for (const auto* e : outside) {
       if (pf) break;
-      snapshot = e->particle_snapshot(members);
+      snapshot = e->particle_snapshot(local);
       if (snapshot) pf = e;
     }
     const bool density = pf && next_density_ < density_times_.size() && t >= density_times_[next_density_] - 1e-9;
-    for (int member : members) {
-      const auto x = row(bank.truths().state(), member);
-      for (int i = 0; i < n; ++i) add_trajectory(member, t, i, "truth", x(i), x(i), x(i));
-      for (const auto& name : bank.filter_names())
-        bank.with_slot(
-            name, [&](const auto& slot) { add_gaussian(member, t, name, row(slot.m, member), row(slot.P, member)); });
-      for (const auto* e : outside) {
-        if (e == pf) {
-          const auto mean = row(pf->mean(), member);
-          for (int i = 0; i < n; ++i) {
-            const std::vector<double> band = snapshot->quantiles(member, i, {0.05, 0.95});
-            add_trajectory(member, t, i, pf->name(), mean(i), band[0], band[1]);
-          }
-        } else {
-          add_gaussian(member, t, e->name(), row(e->mean(), member), row(e->covariance(), member));
-        }
-      }
+    for (long member : members_) {
+      std::string rows;
+      if (share_.holds(member)) rows = trajectory_rows(t, member, member - share_.first, bank, outside, pf, snapshot);
+      trajectories_ += collective::broadcast(rows, member_owner(member, share_.total));
     }
     if (density) {
       while (next_density_ < density_times_.size() && t >= density_times_[next_density_] - 1e-9) ++next_density_;
-      add_density(t, members.front(), bank, outside, *pf, *snapshot);
+      const long member = members_.front();
+      std::string rows;
+      if (share_.holds(member)) rows = density_rows(t, member, member - share_.first, bank, outside, *pf, *snapshot);
+      density_ += collective::broadcast(rows, member_owner(member, share_.total));
+      density_taken_ = true;
     }
   }
 
@@ -87,33 +83,63 @@ class TrajectoryRecorder {
     return host_copy(Kokkos::subview(v, member, Kokkos::ALL));
   }
 
-  void add_trajectory(long member, double t, int i, const std::string& series, double estimate, double lower,
-                      double upper) {
-    trajectories_ += std::to_string(member) + "," + format_number(t) + "," + std::to_string(i) + "," + series + "," +
-                     format_number(estimate) + "," + format_number(lower) + "," + format_number(upper) + "\n";
+  /// Global member `member`, row `local` of this rank's bank, at time t.
+  template <class TruthModel>
+  static std::string trajectory_rows(double t, long member, long local,
+                                     const FilterBank<ExecSpace, Model, TruthModel>& bank,
+                                     const std::vector<const ReferenceEstimator<MemSpace>*>& outside,
+                                     const ReferenceEstimator<MemSpace>* pf,
+                                     const std::optional<ParticleSnapshot>& snapshot) {
+    std::string rows;
+    const auto x = row(bank.truths().state(), local);
+    for (int i = 0; i < n; ++i) add_trajectory(rows, member, t, i, "truth", x(i), x(i), x(i));
+    for (const auto& name : bank.filter_names())
+      bank.with_slot(
+          name, [&](const auto& slot) { add_gaussian(rows, member, t, name, row(slot.m, local), row(slot.P, local)); });
+    for (const auto* e : outside) {
+      if (e == pf) {
+        const auto mean = row(pf->mean(), local);
+        for (int i = 0; i < n; ++i) {
+          const std::vector<double> band = snapshot->quantiles(static_cast<int>(local), i, {0.05, 0.95});
+          add_trajectory(rows, member, t, i, pf->name(), mean(i), band[0], band[1]);
+        }
+      } else {
+        add_gaussian(rows, member, t, e->name(), row(e->mean(), local), row(e->covariance(), local));
+      }
+    }
+    return rows;
+  }
+
+  static void add_trajectory(std::string& rows, long member, double t, int i, const std::string& series,
+                             double estimate, double lower, double upper) {
+    rows += std::to_string(member) + "," + format_number(t) + "," + std::to_string(i) + "," + series + "," +
+            format_number(estimate) + "," + format_number(lower) + "," + format_number(upper) + "\n";
   }
 
   template <class MeanRow, class CovarianceRow>
-  void add_gaussian(long member, double t, const std::string& name, const MeanRow& m, const CovarianceRow& P) {
+  static void add_gaussian(std::string& rows, long member, double t, const std::string& name, const MeanRow& m,
+                           const CovarianceRow& P) {
     for (int i = 0; i < n; ++i) {
       const double sd = std::sqrt(std::max(0.0, P(packed_index(n, i, i))));
-      add_trajectory(member, t, i, name, m(i), m(i) - 2.0 * sd, m(i) + 2.0 * sd);
+      add_trajectory(rows, member, t, i, name, m(i), m(i) - 2.0 * sd, m(i) + 2.0 * sd);
     }
   }
 
   template <class TruthModel>
-  void add_density(double t, int member, const FilterBank<ExecSpace, Model, TruthModel>& bank,
-                   const std::vector<const ReferenceEstimator<MemSpace>*>& outside,
-                   const ReferenceEstimator<MemSpace>& pf, const ParticleSnapshot& snapshot) {
-    density_taken_ = true;
+  static std::string density_rows(double t, long member, long local,
+                                  const FilterBank<ExecSpace, Model, TruthModel>& bank,
+                                  const std::vector<const ReferenceEstimator<MemSpace>*>& outside,
+                                  const ReferenceEstimator<MemSpace>& pf, const ParticleSnapshot& snapshot) {
+    std::string rows;
+    const int column = static_cast<int>(local);
     // The range holds the particle mass (0.1%-99.9%) with a margin, so that the filters' bells show too.
-    const std::vector<double> q = snapshot.quantiles(member, 0, {0.001, 0.999});
+    const std::vector<double> q = snapshot.quantiles(column, 0, {0.001, 0.999});
     const double margin = 0.25 * std::max(q[1] - q[0], 1e-12);
     const double lo = q[0] - margin, hi = q[1] + margin, width = (hi - lo) / density_bins;
-    const std::vector<double> histogram = snapshot.histogram(member, 0, lo, hi, density_bins);
+    const std::vector<double> histogram = snapshot.histogram(column, 0, lo, hi, density_bins);
     auto add = [&](const std::string& series, double x, double d) {
-      density_ += format_number(t) + "," + std::to_string(member) + "," + format_number(x) + "," + series + "," +
-                  format_number(d) + "\n";
+      rows += format_number(t) + "," + std::to_string(member) + "," + format_number(x) + "," + series + "," +
+              format_number(d) + "\n";
     };
     for (int b = 0; b < density_bins; ++b) add(pf.name(), lo + (b + 0.5) * width, histogram[b]);
     auto bell = [&](const std::string& name, double mean, double variance) {
@@ -124,14 +150,16 @@ class TrajectoryRecorder {
       }
     };
     for (const auto& name : bank.filter_names())
-      bank.with_slot(name, [&](const auto& slot) { bell(name, row(slot.m, member)(0), row(slot.P, member)(0)); });
+      bank.with_slot(name, [&](const auto& slot) { bell(name, row(slot.m, local)(0), row(slot.P, local)(0)); });
     for (const auto* e : outside)
-      if (e != &pf) bell(e->name(), row(e->mean(), member)(0), row(e->covariance(), member)(0));
-    add("truth", row(bank.truths().state(), member)(0), 0.0);
+      if (e != &pf) bell(e->name(), row(e->mean(), local)(0), row(e->covariance(), local)(0));
+    add("truth", row(bank.truths().state(), local)(0), 0.0);
+    return rows;
   }
 
   std::vector<long> members_;
   std::vector<double> density_times_;
+  MemberShare share_;
   std::size_t next_density_ = 0;
   bool density_taken_ = false;
   std::string trajectories_, density_;
