@@ -5,14 +5,16 @@
 #include <sched.h>
 
 #include <algorithm>
-#include <thread>
-
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #if defined(KOKKOS_ENABLE_CUDA)
 #include <cuda_runtime_api.h>
+#endif
+#if defined(KOKKOS_ENABLE_OPENMP)
+#include <omp.h>
 #endif
 
 namespace kushner {
@@ -96,6 +98,16 @@ std::optional<double> available_memory_bytes(const std::string& name) {
   return std::nullopt;
 }
 
+namespace {
+void set_openmp_threads(unsigned threads) {
+#if defined(KOKKOS_ENABLE_OPENMP)
+  omp_set_num_threads(static_cast<int>(threads));
+#else
+  (void)threads;
+#endif
+}
+}  // namespace
+
 int ranks_sharing_memory(const std::string& name) {
   int devices = 1;
 #if defined(KOKKOS_ENABLE_CUDA)
@@ -123,8 +135,9 @@ KokkosSession::KokkosSession() {
     const unsigned hardware = std::thread::hardware_concurrency();
     const bool unbound =
         sched_getaffinity(0, sizeof mask, &mask) == 0 && CPU_COUNT(&mask) >= static_cast<int>(hardware);
+    // OpenMP read OMP_NUM_THREADS when it was loaded: set its thread count itself.
     if (unbound && std::getenv("OMP_NUM_THREADS") == nullptr)
-      setenv("OMP_NUM_THREADS", std::to_string(std::max(1u, hardware / local_ranks())).c_str(), 1);
+      set_openmp_threads(std::max(1u, hardware / local_ranks()));
   }
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
