@@ -41,7 +41,7 @@ enum class Stream : std::uint32_t {
 struct Seed {
   std::uint32_t value = 0;
   std::uint32_t first_member = 0;
-  KOKKOS_INLINE_FUNCTION constexpr Seed() = default;
+  constexpr Seed() = default;
   // Implicit: a bare seed is a whole ensemble in one process.
   KOKKOS_INLINE_FUNCTION constexpr Seed(std::uint32_t seed) : value(seed) {}  // NOLINT(google-explicit-constructor)
   KOKKOS_INLINE_FUNCTION constexpr Seed(std::uint32_t seed, std::uint32_t first) : value(seed), first_member(first) {}
