@@ -135,9 +135,10 @@ std::vector<double> broadcast(const std::vector<double>& value, int) { return va
 
 MemberShare member_share(long members, int rank, int ranks) {
   const long blocks = (members + moment_block_size - 1) / moment_block_size;
-  // Blocks ceil(r blocks / ranks) .. ceil((r + 1) blocks / ranks) - 1 for rank r: shares differ by one block at
-  // most, lower ranks take the extra ones.
-  const long first_block = (rank * blocks + ranks - 1) / ranks, end_block = ((rank + 1L) * blocks + ranks - 1) / ranks;
+  // Blocks floor(r blocks / ranks) .. floor((r + 1) blocks / ranks) - 1 for rank r: shares differ by one block at
+  // most, and the last rank, which holds the last (short) block, is one of those with the extra block, so no two
+  // shares differ by more than 256 members.
+  const long first_block = rank * blocks / ranks, end_block = (rank + 1L) * blocks / ranks;
   MemberShare share;
   share.total = members;
   share.first = std::min(members, first_block * moment_block_size);

@@ -1,10 +1,10 @@
 #pragma once
 // How the members of a run are split over MPI ranks: contiguous shares made of whole blocks of
 // moment_block_size members (kernels/ensemble_moments.hpp), blocks dealt out as evenly as whole blocks allow,
-// lower ranks first. The ensemble moments reduce each block alone and merge the blocks in order, so when no
-// block straddles two ranks the merged blocks, and every reported number, are the same bits for any number of
-// ranks. Members draw their random numbers by global index (Seed::first_member), so a member's path is the same
-// whichever rank runs it.
+// the extra ones to the last ranks. The ensemble moments reduce each block alone and merge the blocks in order, so when
+// no block straddles two ranks the merged blocks, and every reported number, are the same bits for any number of ranks.
+// Members draw their random numbers by global index (Seed::first_member), so a member's path is the same whichever rank
+// runs it.
 #include "kernels/rng.hpp"
 
 #include <cstdint>

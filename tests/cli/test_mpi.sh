@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
 # MPI ensembles: `mpirun -np R kushner ...` for R = 1, 2, 3 (oversubscribed: CI has 2 cores) writes the same
 # bytes as a plain run, in every file of simulate, filter, compare and control. The members are split at block
-# boundaries of 256, so 700 members give 3 ranks one share each and 2 ranks shares of 512 and 188; compare's
-# traced members (the first, whose density is taken, too) and control's traced member sit on the last rank. summary.json is compared byte for byte
-# with its "backend" entry (which records the ranks and threads) taken out. An error on rank 0 ends every rank
-# with one line and exit 2.
+# boundaries of 256, so 700 members give 3 ranks one block each and 2 ranks shares of 256 and 444; compare's
+# traced members (the first, whose density is taken, too) and control's traced member sit on the last rank.
+# summary.json is compared byte for byte with its "backend" entry (which records ranks and threads) taken out.
+# An error on rank 0 ends every rank with one line and exit 2.
 set -euo pipefail
 kushner=$1
 mpirun=$2
