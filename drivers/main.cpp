@@ -178,6 +178,8 @@ std::pair<std::string, int> error_line() {
       return {"kushner: error: not enough memory: " + allocation_failure(message) + "; reduce --members or --particles",
               2};
     return {"kushner: internal error: " + message, 1};
+  } catch (...) {
+    return {"kushner: internal error: an exception of unknown type", 1};
   }
 }
 
