@@ -26,7 +26,8 @@ as_root() {
 }
 
 debian_packages=(g++ cmake make patch dpkg-dev clang-format libeigen3-dev libcli11-dev librandom123-dev nlohmann-json3-dev
-                 libtomlplusplus-dev googletest libgtest-dev libbenchmark-dev python3 python3-numpy python3-matplotlib)
+                 libtomlplusplus-dev googletest libgtest-dev libbenchmark-dev python3 python3-numpy python3-matplotlib
+                 libopenmpi-dev openmpi-bin)
 
 install_packages() {
   command -v dpkg-query >/dev/null || { say "not a Debian system: install ${debian_packages[*]} by hand"; return; }

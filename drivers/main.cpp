@@ -1,17 +1,23 @@
 // kushner: banks of nonlinear stochastic systems and filters. Command-line entry point.
+#include "core/collectives.hpp"
 #include "core/errors.hpp"
 #include "drivers/commands.hpp"
 #include "drivers/config_file.hpp"
 #include "engine/backend.hpp"
+#include "engine/processes.hpp"
 
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <csignal>
+#include <cstdio>
 #include <iostream>
 #include <memory>
 #include <new>
 #include <string>
+#include <thread>
+#include <utility>
 
 namespace kushner {
 namespace {
@@ -122,6 +128,8 @@ int run(int argc, char** argv) {
     return run_control_command(o.control, context);
   }
   if (app->got_subcommand("reproduce")) {
+    KUSHNER_INPUT_REQUIRE(collective::ranks() == 1,
+                          "reproduce runs in one process: run it without mpirun (" << collective::ranks() << " ranks)");
     context.backend = selected_backend();
     return run_reproduce(o.reproduce, context);
   }
@@ -155,6 +163,27 @@ std::string allocation_failure(const std::string& message) {
          between("MemorySpace named \"", "\"") + ")";
 }
 
+/// The one line an error ends the run with, and its exit code.
+std::pair<std::string, int> error_line() {
+  try {
+    throw;
+  } catch (const CLI::ParseError& e) {
+    return {std::string("kushner: error: ") + e.what(), 2};
+  } catch (const InputError& e) {
+    return {std::string("kushner: error: ") + e.what(), 2};
+  } catch (const std::bad_alloc& e) {
+    return {"kushner: error: not enough memory (" + first_line(e.what()) + "); reduce --members or --particles", 2};
+  } catch (const std::exception& e) {
+    const std::string message = first_line(e.what());
+    if (message.rfind("Kokkos failed to allocate memory", 0) == 0)  // Kokkos rethrows bad_alloc as runtime_error
+      return {"kushner: error: not enough memory: " + allocation_failure(message) + "; reduce --members or --particles",
+              2};
+    return {"kushner: internal error: " + message, 1};
+  } catch (...) {
+    return {"kushner: internal error: an exception of unknown type", 1};
+  }
+}
+
 }  // namespace
 }  // namespace kushner
 
@@ -162,26 +191,22 @@ int main(int argc, char** argv) {
   // A file-size limit (ulimit -f) would kill the process with SIGXFSZ mid-write, leaving a .tmp file; ignored,
   // the write fails with EFBIG instead and OutputDirectory reports it like a full disk.
   std::signal(SIGXFSZ, SIG_IGN);
+  kushner::ProcessGroup processes(argc, argv);
+  const bool split = kushner::collective::ranks() > 1;
+  // Every rank computes the same report; rank 0 alone prints it.
+  if (split && kushner::collective::rank() != 0 && std::freopen("/dev/null", "w", stdout) == nullptr) return 1;
   try {
     return kushner::run(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    std::cerr << "kushner: error: " << e.what() << "\n";
-    return 2;
-  } catch (const kushner::InputError& e) {
-    std::cerr << "kushner: error: " << e.what() << "\n";
-    return 2;
-  } catch (const std::bad_alloc& e) {
-    std::cerr << "kushner: error: not enough memory (" << kushner::first_line(e.what())
-              << "); reduce --members or --particles\n";
-    return 2;
-  } catch (const std::exception& e) {
-    const std::string message = kushner::first_line(e.what());
-    if (message.rfind("Kokkos failed to allocate memory", 0) == 0) {  // Kokkos rethrows bad_alloc as runtime_error
-      std::cerr << "kushner: error: not enough memory: " << kushner::allocation_failure(message)
-                << "; reduce --members or --particles\n";
-      return 2;
+  } catch (...) {
+    const auto [line, code] = kushner::error_line();
+    if (!split) {
+      std::cerr << line << "\n";
+      return code;
     }
-    std::cerr << "kushner: internal error: " << message << "\n";
-    return 1;
+    // Bad input fails on every rank alike: rank 0 says so and ends them all. Another rank waits a moment
+    // first, so that it speaks only when it failed alone (e.g. its GPU ran out of memory) and rank 0 did not.
+    if (kushner::collective::rank() != 0) std::this_thread::sleep_for(std::chrono::seconds(2));
+    std::cerr << line << "\n" << std::flush;
+    kushner::end_all_ranks(code);
   }
 }

@@ -1,7 +1,9 @@
 #include "drivers/memory_check.hpp"
 
+#include "core/collectives.hpp"
 #include "core/errors.hpp"
 #include "engine/backend.hpp"
+#include "engine/processes.hpp"
 
 #include <cstdio>
 #include <optional>
@@ -20,9 +22,14 @@ std::string format_bytes(double bytes) {
 void require_memory_fits(double bytes, const std::string& sizes, const std::string& breakdown,
                          const std::string& backend) {
   const std::optional<double> available = available_memory_bytes(backend);
-  KUSHNER_INPUT_REQUIRE(!available || bytes <= *available, sizes << ": the run needs " << format_bytes(bytes) << " ("
-                                                                 << breakdown << "), but " << backend << " has "
-                                                                 << format_bytes(*available) << " available");
+  // Over MPI ranks a rank holds about 1/ranks of the members (shares differ by one 256-member block at most),
+  // and the ranks that share its memory (the node's host memory, or its GPU) need theirs as well.
+  const int ranks = collective::ranks();
+  const double here = ranks > 1 ? bytes * ranks_sharing_memory(backend) / ranks : bytes;
+  KUSHNER_INPUT_REQUIRE(!available || here <= *available,
+                        sizes << ": the run needs " << format_bytes(here) << " (" << breakdown
+                              << (ranks > 1 ? ", for the ranks that share this memory" : "") << "), but " << backend
+                              << " has " << format_bytes(*available) << " available");
 }
 
 }  // namespace kushner

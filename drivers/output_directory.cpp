@@ -1,5 +1,6 @@
 #include "drivers/output_directory.hpp"
 
+#include "core/collectives.hpp"
 #include "core/errors.hpp"
 
 #include <cerrno>
@@ -10,8 +11,9 @@
 namespace kushner {
 
 OutputDirectory::OutputDirectory(const std::filesystem::path& path, const std::string& option)
-    : path_(path), option_(option) {
+    : path_(path), option_(option), writes_(collective::rank() == 0) {
   KUSHNER_INPUT_REQUIRE(!path.empty(), option << ": empty path");
+  if (!writes_) return;
   std::error_code ec;
   if (std::filesystem::exists(path, ec)) {
     KUSHNER_INPUT_REQUIRE(std::filesystem::is_directory(path, ec),
@@ -33,6 +35,7 @@ OutputDirectory::OutputDirectory(const std::filesystem::path& path, const std::s
 void OutputDirectory::write(const std::string& name, const std::string& content) const { write_all({{name, content}}); }
 
 void OutputDirectory::write_all(const std::vector<std::pair<std::string, std::string>>& files) const {
+  if (!writes_) return;
   std::vector<std::filesystem::path> written;  // the .tmp files of this call
   auto remove_written = [&written] {
     std::error_code ignored;

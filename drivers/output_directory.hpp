@@ -11,8 +11,12 @@ namespace kushner {
 class OutputDirectory {
  public:
   /// Creates `path` (and parents) if needed and checks that files can be created in it; InputError naming
-  /// `option` (e.g. "--out") otherwise.
+  /// `option` (e.g. "--out") otherwise. In a run over MPI ranks only rank 0 does, and writes; on the other
+  /// ranks the writes below do nothing (every rank computes the same contents).
   OutputDirectory(const std::filesystem::path& path, const std::string& option);
+
+  /// Whether this process writes (rank 0, or the only process).
+  bool writes() const { return writes_; }
 
   /// Writes `content` to path/name atomically (write name.tmp, then rename). InputError naming the option and
   /// the reason (disk full, ...) when it cannot, with name.tmp removed and path/name as it was.
@@ -28,6 +32,7 @@ class OutputDirectory {
  private:
   std::filesystem::path path_;
   std::string option_;
+  bool writes_ = true;
 };
 
 }  // namespace kushner

@@ -37,6 +37,10 @@ PlotResult write_plots_and_report(const OutputDirectory& out) {
 PlotResult write_plots_and_report(const OutputDirectory& out, const std::string& script_name,
                                   const std::vector<std::string>& figures) {
   PlotResult result;
+  if (!out.writes()) {  // another rank of an MPI run: rank 0 draws them
+    result.message = "drawn by rank 0";
+    return result;
+  }
   const std::filesystem::path script = std::filesystem::path(KUSHNER_SOURCE_DIR) / "drivers/plots" / script_name;
   const std::string command = shell_quote(python_interpreter()) + " " + shell_quote(script.string()) + " " +
                               shell_quote(out.path().string()) + " 2>&1";

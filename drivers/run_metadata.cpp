@@ -1,5 +1,6 @@
 #include "drivers/run_metadata.hpp"
 
+#include "core/collectives.hpp"
 #include "engine/backend.hpp"
 #include "engine/version.hpp"
 
@@ -8,7 +9,8 @@ namespace kushner {
 nlohmann::json backend_json(const BackendDescription& d) {
   nlohmann::json j = {{"name", d.name}, {"kokkos", d.kokkos}};
   if (!d.device.empty()) j["device"] = d.device;
-  if (d.threads > 0) j["threads"] = d.threads;
+  if (d.threads > 0) j["threads"] = d.threads;  // per rank
+  if (collective::ranks() > 1) j["ranks"] = collective::ranks();
   return j;
 }
 

@@ -7,10 +7,12 @@
 // members (snapshot "most_bimodal", scored by bimodality_score): where a Gaussian filter cannot follow the
 // posterior, whatever the chosen times. Only those members are copied to the host, so it costs little next to
 // the run.
+#include "core/collectives.hpp"
 #include "core/errors.hpp"
 #include "drivers/csv.hpp"
 #include "drivers/run_metadata.hpp"
 #include "engine/filter_bank.hpp"
+#include "engine/member_share.hpp"
 #include "engine/reference_estimator.hpp"
 #include "kernels/host_copy.hpp"
 
@@ -19,6 +21,7 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -30,6 +33,7 @@ class TrajectoryRecorder {
   using MemSpace = typename ExecSpace::memory_space;
   static constexpr int n = Model::state_dim;
   static constexpr int density_bins = 80;
+  /// Members 0 .. 31 lie in the first block of 256 (engine/member_share.hpp): one rank holds them all.
   static constexpr int bimodal_scan_members = 32;
 
   /// The most bimodal snapshot found (score 0: none scanned, or every posterior had one mode).
@@ -39,9 +43,10 @@ class TrajectoryRecorder {
   };
 
   /// `members`: the members to follow (each below `num_members`); `density_times`: the density
-  /// snapshots are taken at the first output time at or after each of them.
+  /// snapshots are taken at the first output time at or after each of them. In a run over MPI ranks every
+  /// rank records the same text: the rank that holds a member writes its rows and sends them to the others.
   TrajectoryRecorder(const std::vector<long>& members, long num_members, std::vector<double> density_times)
-      : members_(members), density_times_(std::move(density_times)) {
+      : members_(members), density_times_(std::move(density_times)), share_(member_share(num_members)) {
     for (long m : members_)
       KUSHNER_INPUT_REQUIRE(m >= 0 && m < num_members,
                             "--trajectory-members: member " << m << " is not in 0 .. " << num_members - 1);
@@ -53,52 +58,61 @@ class TrajectoryRecorder {
   template <class TruthModel>
   void operator()(double t, const FilterBank<ExecSpace, Model, TruthModel>& bank,
                   const std::vector<const ReferenceEstimator<MemSpace>*>& outside) {
-    std::vector<int> members(members_.begin(), members_.end());
-    if (members.empty()) return;
-    std::vector<int> copied = members;  // the followed members and those scanned for a bimodal posterior
-    for (int m = 0; m < bimodal_.scanned_members; ++m) copied.push_back(m);
-    std::sort(copied.begin(), copied.end());
-    copied.erase(std::unique(copied.begin(), copied.end()), copied.end());
+    if (members_.empty()) return;
+    std::vector<int> local;  // the chosen and scanned members this rank holds, as indices into its bank
+    for (long m : members_)
+      if (share_.holds(m)) local.push_back(static_cast<int>(m - share_.first));
+    for (long m = 0; m < bimodal_.scanned_members; ++m)
+      if (share_.holds(m)) local.push_back(static_cast<int>(m - share_.first));
+    std::sort(local.begin(), local.end());
+    local.erase(std::unique(local.begin(), local.end()), local.end());
     const ReferenceEstimator<MemSpace>* pf = nullptr;  // the first estimator among `outside` made of particles
-    std::optional<ParticleSnapshot> snapshot;          // its particles of `copied`
+    std::optional<ParticleSnapshot> snapshot;          // its particles of `local`
     for (const auto* e : outside) {
       if (pf) break;
-      snapshot = e->particle_snapshot(copied);
+      snapshot = e->particle_snapshot(local);
       if (snapshot) pf = e;
     }
     const bool density = pf && next_density_ < density_times_.size() && t >= density_times_[next_density_] - 1e-9;
-    for (int member : members) {
-      const auto x = row(bank.truths().state(), member);
-      for (int i = 0; i < n; ++i) add_trajectory(member, t, i, "truth", x(i), x(i), x(i));
-      for (const auto& name : bank.filter_names())
-        bank.with_slot(
-            name, [&](const auto& slot) { add_gaussian(member, t, name, row(slot.m, member), row(slot.P, member)); });
-      for (const auto* e : outside) {
-        if (e == pf) {
-          const auto mean = row(pf->mean(), member);
-          for (int i = 0; i < n; ++i) {
-            const std::vector<double> band = snapshot->quantiles(member, i, {0.05, 0.95});
-            add_trajectory(member, t, i, pf->name(), mean(i), band[0], band[1]);
-          }
-        } else {
-          add_gaussian(member, t, e->name(), row(e->mean(), member), row(e->covariance(), member));
-        }
-      }
+    for (long member : members_) {
+      std::string rows;
+      if (share_.holds(member)) rows = trajectory_rows(t, member, member - share_.first, bank, outside, pf, snapshot);
+      trajectories_ += collective::broadcast(rows, member_owner(member, share_.total));
     }
     if (density) {
       while (next_density_ < density_times_.size() && t >= density_times_[next_density_] - 1e-9) ++next_density_;
-      density_ += density_rows("time", t, members.front(), bank, outside, *pf, *snapshot);
+      const long member = members_.front();
+      std::string rows;
+      if (share_.holds(member))
+        rows = density_rows("time", t, member, member - share_.first, bank, outside, *pf, *snapshot);
+      density_ += collective::broadcast(rows, member_owner(member, share_.total));
     }
-    // At t = 0 every posterior is the Gaussian prior.
-    if (pf && t > 0.0)
-      for (int m = 0; m < bimodal_.scanned_members; ++m) {
-        const double score = snapshot->bimodality(m, 0);
-        if (score <= bimodal_.score) continue;
-        bimodal_.score = score;
-        bimodal_.t = t;
-        bimodal_.member = m;
-        bimodal_rows_ = density_rows("most_bimodal", t, m, bank, outside, *pf, *snapshot);
+    // At t = 0 every posterior is the Gaussian prior. The rank holding the scanned members sends the others a
+    // snapshot that beats the best so far ("score t member" and its rows), or nothing.
+    if (pf && t > 0.0 && bimodal_.scanned_members > 0) {
+      std::string update;
+      if (share_.holds(0)) {
+        BimodalSnapshot best = bimodal_;
+        for (long m = 0; m < bimodal_.scanned_members; ++m) {
+          const double score = snapshot->bimodality(static_cast<int>(m - share_.first), 0);
+          if (score <= best.score) continue;
+          best.score = score;
+          best.member = m;
+        }
+        if (best.member != bimodal_.member || best.score != bimodal_.score)
+          update =
+              format_number(best.score) + " " + std::to_string(best.member) + "\n" +
+              density_rows("most_bimodal", t, best.member, best.member - share_.first, bank, outside, *pf, *snapshot);
       }
+      update = collective::broadcast(update, member_owner(0, share_.total));
+      if (!update.empty()) {
+        const std::size_t end = update.find('\n');
+        std::istringstream header(update.substr(0, end));
+        header >> bimodal_.score >> bimodal_.member;
+        bimodal_.t = t;
+        bimodal_rows_ = update.substr(end + 1);
+      }
+    }
   }
 
   const std::string& trajectories_csv() const { return trajectories_; }
@@ -115,33 +129,62 @@ class TrajectoryRecorder {
     return host_copy(Kokkos::subview(v, member, Kokkos::ALL));
   }
 
-  void add_trajectory(long member, double t, int i, const std::string& series, double estimate, double lower,
-                      double upper) {
-    trajectories_ += std::to_string(member) + "," + format_number(t) + "," + std::to_string(i) + "," + series + "," +
-                     format_number(estimate) + "," + format_number(lower) + "," + format_number(upper) + "\n";
+  /// Global member `member`, row `local` of this rank's bank, at time t.
+  template <class TruthModel>
+  static std::string trajectory_rows(double t, long member, long local,
+                                     const FilterBank<ExecSpace, Model, TruthModel>& bank,
+                                     const std::vector<const ReferenceEstimator<MemSpace>*>& outside,
+                                     const ReferenceEstimator<MemSpace>* pf,
+                                     const std::optional<ParticleSnapshot>& snapshot) {
+    std::string rows;
+    const auto x = row(bank.truths().state(), local);
+    for (int i = 0; i < n; ++i) add_trajectory(rows, member, t, i, "truth", x(i), x(i), x(i));
+    for (const auto& name : bank.filter_names())
+      bank.with_slot(
+          name, [&](const auto& slot) { add_gaussian(rows, member, t, name, row(slot.m, local), row(slot.P, local)); });
+    for (const auto* e : outside) {
+      if (e == pf) {
+        const auto mean = row(pf->mean(), local);
+        for (int i = 0; i < n; ++i) {
+          const std::vector<double> band = snapshot->quantiles(static_cast<int>(local), i, {0.05, 0.95});
+          add_trajectory(rows, member, t, i, pf->name(), mean(i), band[0], band[1]);
+        }
+      } else {
+        add_gaussian(rows, member, t, e->name(), row(e->mean(), local), row(e->covariance(), local));
+      }
+    }
+    return rows;
+  }
+
+  static void add_trajectory(std::string& rows, long member, double t, int i, const std::string& series,
+                             double estimate, double lower, double upper) {
+    rows += std::to_string(member) + "," + format_number(t) + "," + std::to_string(i) + "," + series + "," +
+            format_number(estimate) + "," + format_number(lower) + "," + format_number(upper) + "\n";
   }
 
   template <class MeanRow, class CovarianceRow>
-  void add_gaussian(long member, double t, const std::string& name, const MeanRow& m, const CovarianceRow& P) {
+  static void add_gaussian(std::string& rows, long member, double t, const std::string& name, const MeanRow& m,
+                           const CovarianceRow& P) {
     for (int i = 0; i < n; ++i) {
       const double sd = std::sqrt(std::max(0.0, P(packed_index(n, i, i))));
-      add_trajectory(member, t, i, name, m(i), m(i) - 2.0 * sd, m(i) + 2.0 * sd);
+      add_trajectory(rows, member, t, i, name, m(i), m(i) - 2.0 * sd, m(i) + 2.0 * sd);
     }
   }
 
-  /// density.csv's rows of one snapshot: the particle histogram of x1 of `member` at t, each filter's Gaussian
-  /// on the same bins, and the truth.
+  /// density.csv's rows of one snapshot (`kind`): the particle histogram of x1 of global member `member` (row
+  /// `local` of this rank's bank) at t, each filter's Gaussian on the same bins, and the truth.
   template <class TruthModel>
-  std::string density_rows(const std::string& kind, double t, int member,
-                           const FilterBank<ExecSpace, Model, TruthModel>& bank,
-                           const std::vector<const ReferenceEstimator<MemSpace>*>& outside,
-                           const ReferenceEstimator<MemSpace>& pf, const ParticleSnapshot& snapshot) {
+  static std::string density_rows(const std::string& kind, double t, long member, long local,
+                                  const FilterBank<ExecSpace, Model, TruthModel>& bank,
+                                  const std::vector<const ReferenceEstimator<MemSpace>*>& outside,
+                                  const ReferenceEstimator<MemSpace>& pf, const ParticleSnapshot& snapshot) {
     std::string rows;
+    const int column = static_cast<int>(local);
     // The range holds the particle mass (0.1%-99.9%) with a margin, so that the filters' bells show too.
-    const std::vector<double> q = snapshot.quantiles(member, 0, {0.001, 0.999});
+    const std::vector<double> q = snapshot.quantiles(column, 0, {0.001, 0.999});
     const double margin = 0.25 * std::max(q[1] - q[0], 1e-12);
     const double lo = q[0] - margin, hi = q[1] + margin, width = (hi - lo) / density_bins;
-    const std::vector<double> histogram = snapshot.histogram(member, 0, lo, hi, density_bins);
+    const std::vector<double> histogram = snapshot.histogram(column, 0, lo, hi, density_bins);
     auto add = [&](const std::string& series, double x, double d) {
       rows += kind + "," + format_number(t) + "," + std::to_string(member) + "," + format_number(x) + "," + series +
               "," + format_number(d) + "\n";
@@ -155,15 +198,16 @@ class TrajectoryRecorder {
       }
     };
     for (const auto& name : bank.filter_names())
-      bank.with_slot(name, [&](const auto& slot) { bell(name, row(slot.m, member)(0), row(slot.P, member)(0)); });
+      bank.with_slot(name, [&](const auto& slot) { bell(name, row(slot.m, local)(0), row(slot.P, local)(0)); });
     for (const auto* e : outside)
-      if (e != &pf) bell(e->name(), row(e->mean(), member)(0), row(e->covariance(), member)(0));
-    add("truth", row(bank.truths().state(), member)(0), 0.0);
+      if (e != &pf) bell(e->name(), row(e->mean(), local)(0), row(e->covariance(), local)(0));
+    add("truth", row(bank.truths().state(), local)(0), 0.0);
     return rows;
   }
 
   std::vector<long> members_;
   std::vector<double> density_times_;
+  MemberShare share_;
   std::size_t next_density_ = 0;
   BimodalSnapshot bimodal_;
   std::string trajectories_, density_, bimodal_rows_;

@@ -1,11 +1,20 @@
 #include "engine/backend.hpp"
 
+#include "engine/processes.hpp"
+
+#include <sched.h>
+
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #if defined(KOKKOS_ENABLE_CUDA)
 #include <cuda_runtime_api.h>
+#endif
+#if defined(KOKKOS_ENABLE_OPENMP)
+#include <omp.h>
 #endif
 
 namespace kushner {
@@ -89,12 +98,52 @@ std::optional<double> available_memory_bytes(const std::string& name) {
   return std::nullopt;
 }
 
+namespace {
+void set_openmp_threads(unsigned threads) {
+#if defined(KOKKOS_ENABLE_OPENMP)
+  omp_set_num_threads(static_cast<int>(threads));
+#else
+  (void)threads;
+#endif
+}
+}  // namespace
+
+int ranks_sharing_memory(const std::string& name) {
+  int devices = 1;
+#if defined(KOKKOS_ENABLE_CUDA)
+  if (name == "cuda" && (cudaGetDeviceCount(&devices) != cudaSuccess || devices < 1)) devices = 1;
+  if (name != "cuda") devices = 1;
+#else
+  (void)name;
+#endif
+  return (local_ranks() + devices - 1) / devices;
+}
+
 KokkosSession::KokkosSession() {
   setenv("OMP_PROC_BIND", "false", /*overwrite=*/0);
-  int argc = 1;
-  char name[] = "kushner";
-  char* argv[] = {name, nullptr};
-  Kokkos::initialize(argc, argv);
+  std::vector<std::string> args = {"kushner"};
+  if (local_ranks() > 1) {
+    // Ranks on one node share it: each takes the GPU of its local rank (round robin when there are fewer GPUs,
+    // e.g. two ranks on one GPU), and, when mpirun left it unbound and OMP_NUM_THREADS is unset, its share of
+    // the cores (a rank bound to cores gets as many threads as it has cores from OpenMP itself).
+    int devices = 1;
+#if defined(KOKKOS_ENABLE_CUDA)
+    if (cudaGetDeviceCount(&devices) != cudaSuccess || devices < 1) devices = 1;
+#endif
+    args.push_back("--kokkos-device-id=" + std::to_string(local_rank() % devices));
+    cpu_set_t mask;
+    const unsigned hardware = std::thread::hardware_concurrency();
+    const bool unbound =
+        sched_getaffinity(0, sizeof mask, &mask) == 0 && CPU_COUNT(&mask) >= static_cast<int>(hardware);
+    // OpenMP read OMP_NUM_THREADS when it was loaded: set its thread count itself.
+    if (unbound && std::getenv("OMP_NUM_THREADS") == nullptr)
+      set_openmp_threads(std::max(1u, hardware / local_ranks()));
+  }
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  int argc = static_cast<int>(args.size());
+  Kokkos::initialize(argc, argv.data());
 }
 
 KokkosSession::~KokkosSession() { Kokkos::finalize(); }

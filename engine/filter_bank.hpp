@@ -56,7 +56,7 @@ struct FilterScores {
 /// (engine/control/closed_loop.hpp).
 template <class Filter, class MemSpace, class Model>
 void enable_filter_slot(FilterSlot<Filter, MemSpace>& slot, const Model& model, long members,
-                        const OptionValues& options, const std::optional<Filter>& ready, std::uint32_t seed) {
+                        const OptionValues& options, const std::optional<Filter>& ready, Seed seed) {
   constexpr int n = Model::state_dim;
   slot.enabled = true;
   slot.filter =
@@ -116,8 +116,8 @@ class FilterBank {
   /// order; `options`: their settings (declared defaults where absent). The truths follow truth_model, the
   /// filters filter_model (the same in most runs; tests set them apart to show that a test can fail, and
   /// `kushner reproduce` runs filters of a Taylor model on the system it approximates).
-  FilterBank(const ExecSpace& space, const TruthModel& truth_model, const Model& filter_model, long members,
-             std::uint32_t seed, const std::vector<std::string>& filters, const OptionValues& options = {},
+  FilterBank(const ExecSpace& space, const TruthModel& truth_model, const Model& filter_model, long members, Seed seed,
+             const std::vector<std::string>& filters, const OptionValues& options = {},
              const PreparedFilters& prepared = {})
       : space_(space),
         truth_model_(truth_model),
@@ -333,7 +333,7 @@ class FilterBank {
   template <class View>
   Estimate mean(const View& x, int column) const {
     const EnsembleMoments mo = column_moments(x, column);
-    const long count = members_ - mo.non_finite;
+    const long count = mo.members - mo.non_finite;  // over every rank
     return {mo.mean[0], count > 1 ? std::sqrt(mo.variance[0] / count) : std::nan(""), count};
   }
   /// sqrt of a mean, with the delta-method standard error se(mean) / (2 sqrt(mean)).
@@ -348,7 +348,7 @@ class FilterBank {
   TruthModel truth_model_;
   Model filter_model_;
   long members_;
-  std::uint32_t seed_;
+  Seed seed_;
   TruthBank<ExecSpace, TruthModel> truths_;
   BankScalar<Status, MemSpace> truth_status_;
   typename K::Slots slots_;

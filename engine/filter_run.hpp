@@ -10,6 +10,7 @@
 #include "core/options.hpp"
 #include "engine/exact_reference_estimator.hpp"
 #include "engine/filter_bank.hpp"
+#include "engine/member_share.hpp"
 #include "engine/particle_reference.hpp"
 #include "engine/progress_callback.hpp"
 #include "engine/time_grid.hpp"
@@ -71,7 +72,7 @@ namespace detail {
 /// passes.
 template <class ExecSpace, class Model, class TruthModel>
 typename FilterBank<ExecSpace, Model, TruthModel>::PreparedFilters prepare_filters(
-    const ExecSpace& space, const TruthModel& truth_model, const Model& filter_model, long members, std::uint32_t seed,
+    const ExecSpace& space, const TruthModel& truth_model, const Model& filter_model, long members, Seed seed,
     const TimeGrid& grid, const std::vector<std::string>& filters, const OptionValues& options,
     const ProgressCallback& progress, long& progress_base) {
   using Bank = FilterBank<ExecSpace, Model, TruthModel>;
@@ -108,6 +109,9 @@ typename FilterBank<ExecSpace, Model, TruthModel>::PreparedFilters prepare_filte
 /// them, in their order). The truths follow truth_model, the filters filter_model. With PF, EXACT or an extra
 /// estimator, every other estimate is also scored against the reference's mean (rmse_ref): the first of PF,
 /// EXACT, extra[0], ... `progress` counts the steps of all passes (progress_steps).
+///
+/// `members` is the whole ensemble: in a run over MPI ranks each rank runs its share (engine/member_share.hpp),
+/// and the report, the same on every rank, covers all members. `observer` sees this rank's bank.
 template <class ExecSpace, class Model, class TruthModel>
 FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, const Model& filter_model, long members,
                          std::uint32_t seed, const TimeGrid& grid, const std::vector<std::string>& filters,
@@ -116,6 +120,9 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
                          const OutputObserver<ExecSpace, Model, TruthModel>& observer = {},
                          ExtraEstimators<ExecSpace> extra = {}) {
   using MemSpace = typename ExecSpace::memory_space;
+  const MemberShare share = member_share(members);
+  const Seed rank_seed = share.seed(seed);
+  members = share.count;
   FilterReport report;
   report.filters = filters;
   std::vector<std::string> bank_filters;
@@ -126,7 +133,7 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
     } else if (name == particle_filter_name) {
       if constexpr (particle_filter_unsupported<Model>() == nullptr)
         outside.push_back(
-            std::make_unique<ParticleReference<ExecSpace, Model>>(space, filter_model, members, seed, particle));
+            std::make_unique<ParticleReference<ExecSpace, Model>>(space, filter_model, members, rank_seed, particle));
     } else if constexpr (has_exact_reference<Model>) {
       outside.push_back(std::make_unique<ExactReferenceEstimator<ExecSpace, Model>>(space, filter_model, members));
     }
@@ -140,10 +147,10 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
     outside.push_back(std::move(e));
   }
   long progress_base = 0;
-  const auto prepared = detail::prepare_filters(space, truth_model, filter_model, members, seed, grid, bank_filters,
-                                                options, progress, progress_base);
-  FilterBank<ExecSpace, Model, TruthModel> bank(space, truth_model, filter_model, members, seed, bank_filters, options,
-                                                prepared);
+  const auto prepared = detail::prepare_filters(space, truth_model, filter_model, members, rank_seed, grid,
+                                                bank_filters, options, progress, progress_base);
+  FilterBank<ExecSpace, Model, TruthModel> bank(space, truth_model, filter_model, members, rank_seed, bank_filters,
+                                                options, prepared);
   std::vector<const ReferenceEstimator<MemSpace>*> outside_view;
   if (!outside.empty()) {
     bank.set_reference(outside.front().get());  // PF comes before EXACT

@@ -68,14 +68,14 @@ class ParticleFilterBank {
   static constexpr int state_dim = Model::state_dim;
   static_assert(!Model::discrete_time, "ParticleFilterBank: continuous-time models only (dy increments)");
 
-  ParticleFilterBank(const ExecSpace& space, const Model& model, int num_members, int num_particles, std::uint32_t seed,
+  ParticleFilterBank(const ExecSpace& space, const Model& model, int num_members, int num_particles, Seed seed,
                      ResamplingScheme scheme = ResamplingScheme::systematic, double ess_threshold = 0.5)
       : ParticleFilterBank(space, model, num_members, num_particles, seed,
                            ParticleFilterOptions{scheme, ess_threshold}) {}
 
   /// Samples the initial particles and computes the time-0 posterior. Requires sizes >= 1 and a threshold in
   /// [0, 1] (std::logic_error otherwise: user input is checked where it is read, drivers/filter_options.cpp).
-  ParticleFilterBank(const ExecSpace& space, const Model& model, int num_members, int num_particles, std::uint32_t seed,
+  ParticleFilterBank(const ExecSpace& space, const Model& model, int num_members, int num_particles, Seed seed,
                      const ParticleFilterOptions& options)
       : space_(space),
         model_(model),
@@ -423,7 +423,7 @@ class ParticleFilterBank {
   ExecSpace space_;
   Model model_;
   ParticleFilterOptions options_;
-  std::uint32_t seed_;
+  Seed seed_;
   int num_members_, num_particles_;
   bool use_team_ = false;
   int block_size_ = 0, num_blocks_ = 0, team_size_ = 1;

@@ -5,6 +5,7 @@
 // the squared Monte Carlo error of the particle mean (Kong, Liu & Wong 1994): rmse_ref cannot tell apart
 // filters closer to the particle mean than its root mean, the reference's noise floor. Reduced on the host
 // in member order, so the figures are the same on any number of threads.
+#include "core/collectives.hpp"
 #include "engine/particle_filter_bank.hpp"
 #include "engine/reference_estimator.hpp"
 #include "kernels/for_each_member.hpp"
@@ -13,6 +14,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <vector>
 
 namespace kushner {
 
@@ -52,7 +54,7 @@ class ParticleReference final : public ReferenceEstimator<typename ExecSpace::me
  public:
   using MemSpace = typename ExecSpace::memory_space;
 
-  ParticleReference(const ExecSpace& space, const Model& model, long members, std::uint32_t seed,
+  ParticleReference(const ExecSpace& space, const Model& model, long members, Seed seed,
                     const ParticleSettings& settings)
       : space_(space),
         pf_(space, model, static_cast<int>(members), settings.particles, seed, settings.options),
@@ -74,13 +76,21 @@ class ParticleReference final : public ReferenceEstimator<typename ExecSpace::me
     space_.fence();
     const auto sums = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sums_);
     const auto resamples = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pf_.resample_count());
+    // Every rank's members in member order (collective::gather), summed in that order: the same bits for any
+    // number of ranks. Resample counts are exact in a double.
+    std::vector<double> local;
+    for (int m = 0; m < pf_.num_members(); ++m)
+      local.insert(local.end(), {sums(m, 0), sums(m, 1), static_cast<double>(resamples(m))});
+    const std::vector<double> all = collective::gather(local);
     double ess_total = 0.0, squared_error_total = 0.0;
     long resample_total = 0;
-    for (int m = 0; m < pf_.num_members(); ++m) {
-      if (!std::isfinite(sums(m, 0)) || !std::isfinite(sums(m, 1))) continue;  // a member that left the numbers
-      ess_total += sums(m, 0), squared_error_total += sums(m, 1), resample_total += resamples(m);
+    const long members = static_cast<long>(all.size()) / 3;
+    for (long m = 0; m < members; ++m) {
+      const double* row = all.data() + 3 * m;
+      if (!std::isfinite(row[0]) || !std::isfinite(row[1])) continue;  // a member that left the numbers
+      ess_total += row[0], squared_error_total += row[1], resample_total += static_cast<long>(row[2]);
     }
-    const double member_steps = static_cast<double>(pf_.num_members()) * steps_;
+    const double member_steps = static_cast<double>(members) * steps_;
     return {{"kind", std::string("particle filter")},
             {"particles", static_cast<long>(pf_.num_particles())},
             {"resampling", std::string(to_string(pf_.options().scheme))},

@@ -2,6 +2,7 @@
 // Simulates the bank of truths over a time grid and records ensemble moments at the grid's output steps.
 // Shared by `kushner simulate`, the tests and the benchmarks.
 #include "core/eigen_helpers.hpp"
+#include "engine/member_share.hpp"
 #include "engine/progress_callback.hpp"
 #include "engine/time_grid.hpp"
 #include "kernels/ensemble_moments.hpp"
@@ -22,7 +23,7 @@ class TruthBank {
  public:
   using MemSpace = typename ExecSpace::memory_space;
 
-  TruthBank(const ExecSpace& space, const Model& model, long members, std::uint32_t seed)
+  TruthBank(const ExecSpace& space, const Model& model, long members, Seed seed)
       : space_(space),
         model_(model),
         seed_(seed),
@@ -43,14 +44,15 @@ class TruthBank {
  private:
   ExecSpace space_;
   Model model_;
-  std::uint32_t seed_;
+  Seed seed_;
   BankVector<MemSpace> x_, observations_;
 };
 
 template <class ExecSpace, class Model>
 MomentSeries simulate_ensemble(const ExecSpace& space, const Model& model, long members, std::uint32_t seed,
                                const TimeGrid& grid, const ProgressCallback& progress = {}) {
-  TruthBank<ExecSpace, Model> bank(space, model, members, seed);
+  const MemberShare share = member_share(members);  // this rank's members; the moments cover every rank's
+  TruthBank<ExecSpace, Model> bank(space, model, share.count, share.seed(seed));
   MomentSeries series;
   std::size_t next_output = 0;
   for (long k = 0;; ++k) {

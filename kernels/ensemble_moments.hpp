@@ -3,7 +3,10 @@
 // number of threads: each block of `block_size` consecutive members is reduced sequentially (Welford) by one
 // thread, and the host merges the blocks in order (Chan et al.). A Kokkos parallel_reduce would combine
 // partial sums in an order that depends on the thread count. Members with a non-finite entry (a path that
-// escaped to infinity) are left out and counted.
+// escaped to infinity) are left out and counted. A run split over MPI ranks splits at block boundaries
+// (engine/member_share.hpp): the blocks of every rank are gathered and merged in the same order, so the moments
+// are the same bits for any number of ranks as well.
+#include "core/collectives.hpp"
 #include "core/math.hpp"
 #include "kernels/bank.hpp"
 
@@ -49,6 +52,7 @@ struct EnsembleMoments {
   std::vector<double> mean;      // per column, over finite members
   std::vector<double> variance;  // per column, sample variance (divisor finite members - 1)
   long non_finite = 0;           // members left out
+  long members = 0;              // members of every rank, finite or not
 };
 
 /// Mean and sample variance of every column of x(member, column) over members.
@@ -66,12 +70,22 @@ EnsembleMoments ensemble_moments(const ExecSpace& space, const View& x) {
                        BlockMoments<MemSpace>{x, blocks});
   space.fence();
   const auto host = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), blocks);
+  // Every rank's blocks, row after row, in rank order: the blocks of the whole ensemble in member order.
+  const int width = 1 + 2 * columns;
+  std::vector<double> local(static_cast<std::size_t>(num_blocks) * width);
+  for (int b = 0; b < num_blocks; ++b)
+    for (int j = 0; j < width; ++j) local[static_cast<std::size_t>(b) * width + j] = host(b, j);
+  const std::vector<double> all = collective::gather(local);
+  const long all_blocks = static_cast<long>(all.size()) / width;
+  const long all_members = collective::sum(members);
 
-  EnsembleMoments result{std::vector<double>(columns, 0.0), std::vector<double>(columns, 0.0), members};
+  EnsembleMoments result{std::vector<double>(columns, 0.0), std::vector<double>(columns, 0.0), all_members,
+                         all_members};
   for (int c = 0; c < columns; ++c) {
     double count = 0.0, mean = 0.0, m2 = 0.0;
-    for (int b = 0; b < num_blocks; ++b) {
-      const double nb = host(b, 0), mean_b = host(b, 1 + c), m2_b = host(b, 1 + columns + c);
+    for (long b = 0; b < all_blocks; ++b) {
+      const double* row = all.data() + b * width;
+      const double nb = row[0], mean_b = row[1 + c], m2_b = row[1 + columns + c];
       if (nb == 0) continue;
       const double total = count + nb;
       const double delta = mean_b - mean;
@@ -81,7 +95,7 @@ EnsembleMoments ensemble_moments(const ExecSpace& space, const View& x) {
     }
     result.mean[c] = count > 0 ? mean : std::numeric_limits<double>::quiet_NaN();
     result.variance[c] = count > 1 ? m2 / (count - 1) : std::numeric_limits<double>::quiet_NaN();
-    result.non_finite = members - static_cast<long>(count);
+    result.non_finite = all_members - static_cast<long>(count);
   }
   return result;
 }

@@ -4,7 +4,8 @@
 // on CPU or GPU, and in any order of evaluation.
 //
 //   key     = {seed, stream}                    -- distinct streams are distinct Philox keys: never overlap
-//   counter = {member, particle, step, draw}    -- draw counts Philox blocks within one (member, particle, step)
+//   counter = {member, particle, step, draw}    -- draw counts Philox blocks within one (member, particle, step);
+//                                                  member is the global index (Seed::first_member + local)
 //
 // Normals: each Philox block (4 x 32 bits) gives two 52-bit uniforms u1, u2 in (0, 1), and Box-Muller
 // turns them into two independent standard normals sqrt(-2 ln u1) (cos 2 pi u2, sin 2 pi u2). Box-Muller,
@@ -34,8 +35,20 @@ enum class Stream : std::uint32_t {
   filter_observation = 9,  // perturbed observations of a randomized filter (the stochastic EnKBF)
 };
 
+/// The run's seed and the global index of this process's first member: a process running members
+/// [first_member, first_member + count) of an ensemble split over MPI ranks draws, for its local member i, the
+/// numbers of global member first_member + i, so a member's numbers do not depend on how members are split.
+struct Seed {
+  std::uint32_t value = 0;
+  std::uint32_t first_member = 0;
+  constexpr Seed() = default;
+  // Implicit: a bare seed is a whole ensemble in one process.
+  KOKKOS_INLINE_FUNCTION constexpr Seed(std::uint32_t seed) : value(seed) {}  // NOLINT(google-explicit-constructor)
+  KOKKOS_INLINE_FUNCTION constexpr Seed(std::uint32_t seed, std::uint32_t first) : value(seed), first_member(first) {}
+};
+
 struct RngKey {
-  std::uint32_t seed;
+  Seed seed;
   Stream stream;
 };
 
@@ -44,8 +57,8 @@ struct Counter {
 };
 
 KOKKOS_INLINE_FUNCTION r123array4x32 philox_block(const RngKey& key, const Counter& c) {
-  const r123array2x32 k = {{key.seed, static_cast<std::uint32_t>(key.stream)}};
-  const r123array4x32 ctr = {{c.member, c.particle, c.step, c.draw}};
+  const r123array2x32 k = {{key.seed.value, static_cast<std::uint32_t>(key.stream)}};
+  const r123array4x32 ctr = {{c.member + key.seed.first_member, c.particle, c.step, c.draw}};
   return philox4x32(ctr, k);
 }
 

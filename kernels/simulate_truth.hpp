@@ -61,7 +61,8 @@ struct EulerMaruyamaTruthStep {
   Model model;
   BankVector<MemSpace> x, dy;
   double t, dt;
-  std::uint32_t seed, step;
+  Seed seed;
+  std::uint32_t step;
 
   KOKKOS_INLINE_FUNCTION void operator()(const int member) const { step_member(member, Model::Control::zero()); }
 
@@ -87,7 +88,8 @@ template <class Model, class MemSpace>
 struct DiscreteTruthStep {
   Model model;
   BankVector<MemSpace> x, z;
-  std::uint32_t seed, step;
+  Seed seed;
+  std::uint32_t step;
 
   KOKKOS_INLINE_FUNCTION void operator()(const int member) const {
     constexpr int n = Model::state_dim, p = Model::obs_dim;
@@ -105,8 +107,7 @@ struct DiscreteTruthStep {
 /// (discrete time). No fence: the caller fences before reading results on the host.
 template <class ExecSpace, class Model, class MemSpace>
 void simulate_truth_step(const ExecSpace& space, const Model& model, const BankVector<MemSpace>& x,
-                         const BankVector<MemSpace>& observations, double t, double dt, std::uint32_t seed,
-                         std::uint32_t step) {
+                         const BankVector<MemSpace>& observations, double t, double dt, Seed seed, std::uint32_t step) {
   static_assert(Kokkos::SpaceAccessibility<ExecSpace, MemSpace>::accessible, "bank not accessible from ExecSpace");
   KUSHNER_REQUIRE(x.extent_int(1) == Model::state_dim,
                   "x has " << x.extent(1) << " columns, " << Model::name << " has state_dim " << Model::state_dim);

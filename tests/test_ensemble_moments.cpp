@@ -1,9 +1,12 @@
 // Fixed-order ensemble moments: equal to a direct two-pass computation, blind to non-finite members (counted),
 // and bitwise the same on every backend.
+#include "engine/member_share.hpp"
 #include "kernels/ensemble_moments.hpp"
 #include "tests/test_spaces.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 namespace kushner {
@@ -58,6 +61,35 @@ TYPED_TEST(EnsembleMomentsTest, EqualToTheSerialResult) {
       EXPECT_NEAR(moments.variance[c], reference.variance[c], 1e-13 * reference.variance[c]);
     }
   }
+}
+
+/// The MPI split: shares cover the members in order, start on block boundaries (so that every rank's blocks are
+/// the single process's blocks and their merge gives the same bits), and differ by 256 members at most.
+TEST(MemberShare, ContiguousBlockAlignedAndBalanced) {
+  for (long members : {1L, 255L, 256L, 700L, 1000L, 2000L, 100000L})
+    for (int ranks = 1; ranks <= 5; ++ranks) {
+      long next = 0, smallest = members, largest = 0;
+      for (int r = 0; r < ranks; ++r) {
+        const MemberShare s = member_share(members, r, ranks);
+        EXPECT_EQ(s.first, next) << members << " members, rank " << r << " of " << ranks;
+        EXPECT_EQ(s.total, members);
+        EXPECT_GE(s.count, 0);
+        if (s.count > 0) {
+          EXPECT_EQ(s.first % moment_block_size, 0) << members << " members, rank " << r << " of " << ranks;
+          EXPECT_EQ(s.seed(7).first_member, static_cast<std::uint32_t>(s.first));
+        }
+        next = s.first + s.count;
+        smallest = std::min(smallest, s.count), largest = std::max(largest, s.count);
+      }
+      EXPECT_EQ(next, members) << members << " members over " << ranks << " ranks";
+      EXPECT_LE(largest - smallest, moment_block_size) << members << " members over " << ranks << " ranks";
+    }
+  EXPECT_EQ(member_share(2000, 0, 2).count, 1024);  // 8 blocks: 4 each, the last one short
+  EXPECT_EQ(member_share(2000, 1, 2).count, 976);
+  EXPECT_EQ(member_share(200, 0, 2).count, 0);  // one block: one rank runs none
+  EXPECT_EQ(member_share(200, 1, 2).count, 200);
+  EXPECT_EQ(member_share(700, 1, 2).first, 256);  // 3 blocks: 1 and 2, the short one in the larger share
+  EXPECT_EQ(member_share(700, 1, 2).count, 444);
 }
 
 }  // namespace

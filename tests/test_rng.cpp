@@ -28,6 +28,23 @@ std::vector<double> draw_normals(Stream stream, int n, double scale = 1.0) {
   return std::vector<double>(host.data(), host.data() + n);
 }
 
+/// A process that runs members [first, first + count) of a split ensemble (MPI ranks) draws, for its local member
+/// i, exactly the numbers of global member first + i: the counter's member is offset by Seed::first_member.
+TEST(Rng, SeedFirstMemberOffsetsTheMemberCounter) {
+  for (std::uint32_t first : {0u, 256u, 512u, 4096u})
+    for (std::uint32_t local : {0u, 1u, 255u}) {
+      const Counter c{local, 3, 7, 1};
+      const r123array4x32 split = philox_block(RngKey{Seed(seed, first), Stream::process_noise}, c);
+      const r123array4x32 whole =
+          philox_block(RngKey{seed, Stream::process_noise}, Counter{first + local, c.particle, c.step, c.draw});
+      for (int w = 0; w < 4; ++w) EXPECT_EQ(split.v[w], whole.v[w]) << "first " << first << ", local " << local;
+    }
+  // and the offset matters: member 0 of the second share is not member 0 of the first
+  const r123array4x32 a = philox_block(RngKey{Seed(seed, 256), Stream::process_noise}, Counter{0, 0, 0, 0});
+  const r123array4x32 b = philox_block(RngKey{seed, Stream::process_noise}, Counter{0, 0, 0, 0});
+  EXPECT_NE(a.v[0], b.v[0]);
+}
+
 double standard_normal_cdf(double x) { return 0.5 * std::erfc(-x / std::sqrt(2.0)); }
 
 /// Kolmogorov-Smirnov statistic of the sample against the standard normal.

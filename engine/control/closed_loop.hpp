@@ -52,10 +52,9 @@ class ControlLoop {
   using PreparedFilters = typename K::Prepared;
 
   /// `estimator`: state_estimator_name, a filter the model supports, or particle_filter_name.
-  ControlLoop(const ExecSpace& space, const Model& model, long members, std::uint32_t seed,
-              const std::string& estimator, const ControlLaw<n, m, MemSpace>& law, const QuadraticCost<n, m>& cost,
-              const OptionValues& options = {}, const ParticleSettings& particle = {},
-              const PreparedFilters& prepared = {})
+  ControlLoop(const ExecSpace& space, const Model& model, long members, Seed seed, const std::string& estimator,
+              const ControlLaw<n, m, MemSpace>& law, const QuadraticCost<n, m>& cost, const OptionValues& options = {},
+              const ParticleSettings& particle = {}, const PreparedFilters& prepared = {})
       : space_(space),
         model_(model),
         members_(members),
@@ -209,7 +208,7 @@ class ControlLoop {
   ExecSpace space_;
   Model model_;
   long members_;
-  std::uint32_t seed_;
+  Seed seed_;
   std::string estimator_;
   ControlLaw<n, m, MemSpace> law_;
   QuadraticCost<n, m> cost_;

@@ -3,10 +3,12 @@
 // after the other on the same members, initial states and noise (engine/control/closed_loop.hpp), with the
 // per-member costs kept so that controllers are compared by paired differences. A bank filter with a pre-pass
 // (ASRE) gets it inside its own loop, with the law it serves.
+#include "core/collectives.hpp"
 #include "core/fields.hpp"
 #include "core/options.hpp"
 #include "engine/control/closed_loop.hpp"
 #include "engine/control/control_laws.hpp"
+#include "engine/member_share.hpp"
 #include "engine/progress_callback.hpp"
 #include "engine/time_grid.hpp"
 #include "kernels/host_copy.hpp"
@@ -61,14 +63,18 @@ long control_progress_steps(const std::vector<ControllerSpec>& specs, const Time
 
 namespace detail {
 
-/// One member's row of a (member, column) view, on the host (host_copy: the row is strided).
+/// Global member `member`'s row of a (member, column) view of this rank's share, on every rank: the rank that
+/// holds it copies it to the host (host_copy: the row is strided) and sends it to the others.
 template <class ExecSpace, class View>
-std::vector<double> host_row(const ExecSpace& space, const View& v, long member) {
-  space.fence();
-  const auto h = host_copy(Kokkos::subview(v, member, Kokkos::ALL));
-  std::vector<double> row(h.extent(0));
-  for (std::size_t i = 0; i < row.size(); ++i) row[i] = h(i);
-  return row;
+std::vector<double> host_row(const ExecSpace& space, const View& v, const MemberShare& share, long member) {
+  std::vector<double> row;
+  if (share.holds(member)) {
+    space.fence();
+    const auto h = host_copy(Kokkos::subview(v, member - share.first, Kokkos::ALL));
+    row.resize(h.extent(0));
+    for (std::size_t i = 0; i < row.size(); ++i) row[i] = h(i);
+  }
+  return collective::broadcast(row, member_owner(member, share.total));
 }
 
 }  // namespace detail
@@ -81,6 +87,10 @@ ControllerRun run_controller(const ExecSpace& space, const Model& model, long me
                              std::vector<double>* times, const ProgressCallback& progress, long& progress_base) {
   using MemSpace = typename ExecSpace::memory_space;
   using Loop = ControlLoop<ExecSpace, Model>;
+  // This rank's members; what the run reports covers every rank's, gathered in member order.
+  const MemberShare share = member_share(members);
+  const Seed rank_seed = share.seed(seed);
+  members = share.count;
   ControllerRun run;
   run.spec = spec;
   const MadeLaw<Model, MemSpace> law = make_law<Model, MemSpace>(spec.law, model, cost, grid);
@@ -95,7 +105,7 @@ ControllerRun run_controller(const ExecSpace& space, const Model& model, long me
       const auto run_alone = [&](const Filter& filter) {
         typename Loop::PreparedFilters only;
         std::get<std::optional<Filter>>(only) = filter;
-        Loop loop(space, model, members, seed, spec.estimator, law.law, cost, options, particle, only);
+        Loop loop(space, model, members, rank_seed, spec.estimator, law.law, cost, options, particle, only);
         for (long k = 0; k < grid.steps; ++k) {
           loop.step(k, grid.dt, false);
           if (progress) progress(progress_base + k + 1);
@@ -109,20 +119,20 @@ ControllerRun run_controller(const ExecSpace& space, const Model& model, long me
     }
   });
 
-  Loop loop(space, model, members, seed, spec.estimator, law.law, cost, options, particle, prepared);
+  Loop loop(space, model, members, rank_seed, spec.estimator, law.law, cost, options, particle, prepared);
   auto record = [&](double t) {
     if (times) times->push_back(t);
     run.state_mean.push_back(ensemble_moments(space, loop.truths().state()).mean);
     run.control_mean.push_back(ensemble_moments(space, loop.control()).mean);
-    const std::vector<double> running = loop.member_running_cost();
+    const std::vector<double> running = collective::gather(loop.member_running_cost());
     double sum = 0.0;
     long count = 0;
     for (double c : running)
       if (std::isfinite(c)) sum += c, ++count;
     run.running_cost_mean.push_back(count > 0 ? sum / count : std::nan(""));
-    run.member_state.push_back(detail::host_row(space, loop.truths().state(), traced_member));
-    run.member_estimate.push_back(detail::host_row(space, loop.estimate(), traced_member));
-    run.member_control.push_back(detail::host_row(space, loop.control(), traced_member));
+    run.member_state.push_back(detail::host_row(space, loop.truths().state(), share, traced_member));
+    run.member_estimate.push_back(detail::host_row(space, loop.estimate(), share, traced_member));
+    run.member_control.push_back(detail::host_row(space, loop.control(), share, traced_member));
   };
   record(0.0);
   std::size_t next_output = 1;
@@ -137,8 +147,8 @@ ControllerRun run_controller(const ExecSpace& space, const Model& model, long me
   }
   progress_base += grid.steps;
   space.fence();
-  run.cost = loop.member_costs();
-  run.control_energy = loop.member_control_energy();
+  run.cost = collective::gather(loop.member_costs());
+  run.control_energy = collective::gather(loop.member_control_energy());
   run.terminal_mean = ensemble_moments(space, loop.truths().state()).mean;
   run.truths_escaped = loop.truths_escaped();
   run.estimator_diverged = loop.estimator_diverged();

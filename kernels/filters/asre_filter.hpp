@@ -14,6 +14,7 @@
 // The pre-pass (prepare) runs the truths with ASRE alone, recording per member and iterate the largest change
 // max_t |m^[i](t) - m^[i-1](t)|_inf (`change`), and picks each member's first iterate below the tolerance;
 // the run then reports that iterate.
+#include "core/collectives.hpp"
 #include "core/errors.hpp"
 #include "kernels/bank.hpp"
 #include "kernels/filters/filter_protocol.hpp"
@@ -131,7 +132,8 @@ struct AsreFilter {
     for (long member = 0; member < members; ++member)
       if (first[member] == 0 && !diverged[member] && max_iterations > first_round)
         rest[member] = max_iterations, any = true;
-    if (any) pass(rest);
+    // `members` is this rank's share: every rank runs the second pass when any member anywhere needs it.
+    if (collective::any(any)) pass(rest);
 
     std::vector<int> per_member(members);
     Iterations s;
@@ -139,7 +141,7 @@ struct AsreFilter {
     s.tolerance = tolerance;
     s.max_iterations = max_iterations;
     s.min = max_iterations;
-    double sum = 0.0;
+    long sum = 0;  // an integer, so that its total over ranks does not depend on their order
     for (long member = 0; member < members; ++member) {
       per_member[member] = first[member] > 0 ? first[member] : max_iterations;
       if (diverged[member]) {
@@ -151,7 +153,13 @@ struct AsreFilter {
       s.max = std::max(s.max, per_member[member]);
       sum += per_member[member];
     }
-    s.mean = members > s.diverged ? sum / (members - s.diverged) : std::nan("");
+    s.diverged = collective::sum(s.diverged);
+    s.not_converged = collective::sum(s.not_converged);
+    s.min = static_cast<int>(collective::min(s.min));
+    s.max = static_cast<int>(collective::max(s.max));
+    sum = collective::sum(sum);
+    const long all_members = collective::sum(members);
+    s.mean = all_members > s.diverged ? static_cast<double>(sum) / (all_members - s.diverged) : std::nan("");
     AsreFilter f = with_iterations(model, per_member);
     f.summary = s;
     return f;

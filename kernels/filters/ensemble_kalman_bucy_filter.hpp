@@ -41,7 +41,7 @@ struct EnsembleKalmanBucyBase {
   static constexpr bool randomized = true;
 
   int num_particles = 0;
-  std::uint32_t seed = 0;
+  Seed seed;
   Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace> ensemble;  // (member, ensemble member, i)
 
   static std::vector<OptionSpec> options() {
@@ -50,8 +50,7 @@ struct EnsembleKalmanBucyBase {
   }
 
   /// The initial ensemble: num_particles draws from N(prior_mean, prior_cov) per member.
-  static void initialize(EnsembleKalmanBucyBase& f, const Model& model, long members, long particles,
-                         std::uint32_t seed) {
+  static void initialize(EnsembleKalmanBucyBase& f, const Model& model, long members, long particles, Seed seed) {
     f.num_particles = static_cast<int>(particles);
     f.seed = seed;
     f.ensemble = decltype(f.ensemble)(Kokkos::view_alloc(Kokkos::WithoutInitializing, "kushner::enkbf_ensemble"),
@@ -160,8 +159,7 @@ struct EnsembleKalmanBucyFilter : EnsembleKalmanBucyBase<Model, MemSpace, false>
   static constexpr const char* description =
       "ensemble Kalman-Bucy filter, deterministic innovation (Bergemann-Reich), --enkbf-particles members";
 
-  static EnsembleKalmanBucyFilter create(const OptionValues& options, const Model& model, long members,
-                                         std::uint32_t seed) {
+  static EnsembleKalmanBucyFilter create(const OptionValues& options, const Model& model, long members, Seed seed) {
     EnsembleKalmanBucyFilter f;
     EnsembleKalmanBucyFilter::initialize(f, model, members, options.integer("enkbf_particles"), seed);
     return f;
@@ -175,7 +173,7 @@ struct StochasticEnsembleKalmanBucyFilter : EnsembleKalmanBucyBase<Model, MemSpa
       "ensemble Kalman-Bucy filter, perturbed observations (stochastic), --enkbf-particles members";
 
   static StochasticEnsembleKalmanBucyFilter create(const OptionValues& options, const Model& model, long members,
-                                                   std::uint32_t seed) {
+                                                   Seed seed) {
     StochasticEnsembleKalmanBucyFilter f;
     StochasticEnsembleKalmanBucyFilter::initialize(f, model, members, options.integer("enkbf_particles"), seed);
     return f;

@@ -2,6 +2,7 @@
 // Per-member metric kernels behind the bank's reports: time averages of the accumulated errors (NaN for a
 // member that is not scored, so that ensemble_moments leaves it out and counts it) and status counts.
 // Integer counts are order-independent, so a parallel_reduce keeps them deterministic.
+#include "core/collectives.hpp"
 #include "core/math.hpp"
 #include "core/status.hpp"
 #include "kernels/bank.hpp"
@@ -59,7 +60,7 @@ long count_status(const ExecSpace& space, const BankScalar<Status, MemSpace>& st
   long count = 0;
   Kokkos::parallel_reduce("kushner::count_status", Kokkos::RangePolicy<ExecSpace>(space, 0, status.extent(0)),
                           CountStatus<MemSpace>{status, truth_status, which}, count);
-  return count;
+  return collective::sum(count);  // over every rank's members
 }
 
 }  // namespace kushner

@@ -19,13 +19,14 @@
 //   KOKKOS_INLINE_FUNCTION void apply_known_input(int member, const Vec<n>& shift) const;  // a filter with means
 //                                                 // of its own besides m (ASRE's iterates) adds a closed loop's
 //                                                 // B u dt to them after its step (kernels/filters/filter_slot.hpp)
-//   static Filter create(const OptionValues&, const Model&, long members, std::uint32_t seed);  // instead of
+//   static Filter create(const OptionValues&, const Model&, long members, Seed seed);  // instead of
 //                                                             // the create above: a filter that draws random
 //   static constexpr bool randomized = true;                  // numbers gets the run's seed, and says so
 //
 // Filters may declare the same option (equal OptionSpec): it is one setting, shared.
 #include "core/fields.hpp"
 #include "core/options.hpp"
+#include "kernels/rng.hpp"
 #include "models/model_facts.hpp"
 #include "models/model_traits.hpp"
 
@@ -72,7 +73,7 @@ struct has_seeded_create : std::false_type {};
 template <class Filter, class Model>
 struct has_seeded_create<Filter, Model,
                          std::void_t<decltype(Filter::create(std::declval<const OptionValues&>(),
-                                                             std::declval<const Model&>(), 0L, std::uint32_t{}))>>
+                                                             std::declval<const Model&>(), 0L, Seed{}))>>
     : std::true_type {};
 
 template <class Filter, class = void>
@@ -124,7 +125,7 @@ const char* filter_unsupported(const Model& model) {
 
 /// Filter::create; a randomized filter's create also takes the run's seed.
 template <class Filter, class Model>
-Filter create_filter(const OptionValues& options, const Model& model, long members, std::uint32_t seed) {
+Filter create_filter(const OptionValues& options, const Model& model, long members, Seed seed) {
   if constexpr (detail::has_seeded_create<Filter, Model>::value)
     return Filter::create(options, model, members, seed);
   else

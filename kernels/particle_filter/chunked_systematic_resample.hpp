@@ -51,7 +51,8 @@ struct ChunkedResampleData {
   Kokkos::View<int*, MemSpace> members;  // the members to resample: entries [0, member_count())
   Kokkos::View<int, MemSpace> member_count;
   int num_particles = 0;
-  std::uint32_t seed = 0, step = 0;
+  Seed seed;
+  std::uint32_t step = 0;
 };
 
 namespace detail {

@@ -25,7 +25,8 @@ struct ParticleResampleStep {
   BankScalar<int, MemSpace> resample;
   int num_particles;
   ResamplingScheme scheme;
-  std::uint32_t seed, step;
+  Seed seed;
+  std::uint32_t step;
 
   KOKKOS_INLINE_FUNCTION void operator()(const Team& team) const {
     const int member = team.league_rank();

@@ -41,7 +41,8 @@ struct ParticleStepData {
   Mat<n, n> initial_root;  // any square root of the initial covariance
   double t = 0.0, dt = 0.0;
   double sqrt_dt = 0.0;  // computed once: nvcc re-evaluated sqrt(dt) for every particle
-  std::uint32_t seed = 0, step = 0;
+  Seed seed;
+  std::uint32_t step = 0;
   int num_particles = 0, block_size = 0;
   bool initialize = false;  // sample the initial law instead of propagating; no observation
 };

@@ -57,7 +57,7 @@ KOKKOS_INLINE_FUNCTION int upper_bound_particle(const View& cumulative, int memb
   return lo < n ? lo : n - 1;
 }
 
-KOKKOS_INLINE_FUNCTION double resampling_uniform(std::uint32_t seed, int member, int slot, std::uint32_t step) {
+KOKKOS_INLINE_FUNCTION double resampling_uniform(Seed seed, int member, int slot, std::uint32_t step) {
   double u0, u1;
   uniform_pair(RngKey{seed, Stream::resampling},
                Counter{static_cast<std::uint32_t>(member), static_cast<std::uint32_t>(slot), step, 0}, u0, u1);
@@ -71,7 +71,7 @@ KOKKOS_INLINE_FUNCTION double resampling_uniform(std::uint32_t seed, int member,
 /// `block_sums`: team scratch with scan_num_blocks(n) doubles.
 template <class Team, class MemSpace, class Scratch>
 KOKKOS_INLINE_FUNCTION void resample_member(const Team& team, const ResamplingWorkspace<MemSpace>& ws, int member,
-                                            int n, ResamplingScheme scheme, std::uint32_t seed, std::uint32_t step,
+                                            int n, ResamplingScheme scheme, Seed seed, std::uint32_t step,
                                             const Scratch& block_sums) {
   const auto& c = ws.cumulative;
   const auto& a = ws.ancestors;
@@ -165,7 +165,8 @@ struct ResampleMembers {
   ResamplingWorkspace<MemSpace> ws;
   int num_particles;
   ResamplingScheme scheme;
-  std::uint32_t seed, step;
+  Seed seed;
+  std::uint32_t step;
 
   KOKKOS_INLINE_FUNCTION void operator()(const typename Kokkos::TeamPolicy<ExecSpace>::member_type& team) const {
     const Scratch block_sums(team.team_scratch(0), scan_num_blocks(num_particles));
@@ -178,7 +179,7 @@ struct ResampleMembers {
 /// `team_size` 0 means resampling_team_size<ExecSpace>(). No fence.
 template <class ExecSpace, class MemSpace>
 void resample_members(const ExecSpace& space, const ResamplingWorkspace<MemSpace>& ws, ResamplingScheme scheme,
-                      std::uint32_t seed, std::uint32_t step, int team_size = 0) {
+                      Seed seed, std::uint32_t step, int team_size = 0) {
   const int n = ws.cumulative.extent_int(0), members = ws.cumulative.extent_int(1);
   KUSHNER_REQUIRE(n > 0 && ws.ancestors.extent_int(0) == n && ws.ancestors.extent_int(1) == members,
                   "ancestors have shape (" << ws.ancestors.extent(0) << ", " << ws.ancestors.extent(1) << "), weights ("

@@ -52,7 +52,8 @@ KOKKOS_INLINE_FUNCTION double uniform_open(std::uint64_t hi, std::uint64_t lo) {
 
 KOKKOS_INLINE_FUNCTION void uniform_pair(const RngKey& key, const Counter& c, double& u0, double& u1) {
   std::uint64_t r[4];
-  philox4x32_10(c.member, c.particle, c.step, c.draw, key.seed, static_cast<std::uint32_t>(key.stream), r);
+  philox4x32_10(c.member + key.seed.first_member, c.particle, c.step, c.draw, key.seed.value,
+                static_cast<std::uint32_t>(key.stream), r);
   u0 = uniform_open(r[0], r[1]);
   u1 = uniform_open(r[2], r[3]);
 }

@@ -1,0 +1,133 @@
+#!/usr/bin/env bash
+# MPI across GPUs (issue 16 part 1), in phases that each fit one device call (<= 10 minutes):
+#   build  build-cuda-mpi/: CUDA + OpenMP + MPI (OpenMPI's mpirun on the GPU machine), the kushner executable
+#   run    `kushner filter --filters PF` on the sine model, N = 65536 particles, T = 2, dt = 1e-3 (2000 steps):
+#          weak scaling  M = 1000 on 1 GPU against M = 2000 on 2 GPUs (one rank per GPU): efficiency t1 / t2
+#          strong scaling M = 2000 on 1 GPU against 2 GPUs: speedup t1 / t2
+#          the M = 2000 outputs of 1 and 2 ranks: every number equal to 1e-12 relative (and whether the bytes are)
+#          On a machine with one GPU the two ranks share it; the summary says so.
+# Each timing is the wall time of the whole command (start-up, CUDA context, run, outputs), best of
+# KUSHNER_REPETITIONS (default 2). Power and SM clock of every GPU are sampled every 500 ms while it runs.
+#   OUT=<dir> KUSHNER_PHASES="build run" perf/run_mpi_gpu.sh
+set -uo pipefail
+here=$(cd "$(dirname "$0")/.." && pwd)
+out=${OUT:-$here/mpi-gpu-out}
+mkdir -p "$out"
+build=$here/build-cuda-mpi
+phases=" ${KUSHNER_PHASES:-build run} "
+want() { [[ "$phases" == *" $1 "* ]]; }
+export PATH=/usr/local/cuda/bin:$PATH CMAKE_POLICY_VERSION_MINIMUM=3.5 OMP_PROC_BIND=false
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+status=0
+log() { echo "== $(date +%T) $*" | tee -a "$out/steps.log"; }
+nvidia-smi --query-gpu=index,name,memory.total,power.limit,clocks.max.sm,driver_version --format=csv \
+  > "$out/gpu.csv" 2>&1
+gpus=$(nvidia-smi -L 2>/dev/null | grep -c '^GPU')
+git -C "$here" describe --always --dirty --abbrev=12 > "$out/git.txt" 2>&1
+mpirun --version 2>&1 | head -1 > "$out/mpirun.txt"
+cat "$out/gpu.csv" "$out/mpirun.txt"
+
+if want build; then
+  log "configure"
+  cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON -DKUSHNER_ENABLE_OPENMP=ON \
+    -DKUSHNER_ENABLE_MPI=ON -DKUSHNER_ENABLE_TESTS=OFF -DKUSHNER_ENABLE_BENCHMARKS=OFF \
+    > "$out/configure.log" 2>&1 || { tail -20 "$out/configure.log"; exit 1; }
+  grep "mpi=" "$out/configure.log"
+  log "build kushner"
+  cmake --build "$build" -j16 --target kushner > "$out/build.log" 2>&1 ||
+    { grep -B2 -A12 -m3 "error" "$out/build.log"; exit 1; }
+  log "built"
+fi
+
+if want run; then
+  [ -x "$build/kushner" ] || { echo "no $build/kushner: run the build phase first" >&2; exit 1; }
+  repetitions=${KUSHNER_REPETITIONS:-2}
+  args=(filter --model sine --filters PF --particles 65536 --T 2 --dt 1e-3 --seed 1 --output-points 20 --quiet)
+  nvidia-smi --query-gpu=timestamp,index,power.draw,clocks.sm,utilization.gpu --format=csv -lms 500 \
+    > "$out/power.csv" 2>/dev/null &
+  sampler=$!
+  # run NAME RANKS MEMBERS: best wall time of `repetitions` runs, in seconds, into $out/NAME.time
+  run() {
+    local name=$1 ranks=$2 members=$3 best="" t0 t1 t
+    for ((i = 0; i < repetitions; ++i)); do
+      rm -rf "$out/$name"
+      t0=$(date +%s.%N)
+      KUSHNER_BACKEND=cuda mpirun -q --bind-to none -np "$ranks" "$build/kushner" "${args[@]}" --members "$members" \
+        --out "$out/$name" > "$out/$name.log" 2>&1 || { status=1; tail -3 "$out/$name.log"; }
+      t1=$(date +%s.%N)
+      t=$(python3 -c "print(f'{$t1 - $t0:.3f}')")
+      best=$(python3 -c "print(min(x for x in [$t, ${best:-1e300}]))")
+    done
+    echo "$best" > "$out/$name.time"
+    log "$name: $ranks rank(s), M = $members: best of $repetitions $best s ($(grep -o '"device": "[^"]*"' "$out/$name/summary.json" | head -1))"
+  }
+  run weak_r1_m1000 1 1000
+  run weak_r2_m2000 2 2000
+  run strong_r1_m2000 1 2000
+  strong_r2=weak_r2_m2000  # the same run: M = 2000 on 2 ranks
+  kill "$sampler" 2>/dev/null
+  python3 - "$out" "$gpus" "$strong_r2" <<'PY' | tee "$out/summary.txt" || status=1
+import json, math, os, sys
+out, gpus, strong_r2 = sys.argv[1], int(sys.argv[2]), sys.argv[3]
+t = lambda name: float(open(os.path.join(out, name + ".time")).read())
+steps, particles = 2000, 65536
+w1, w2, s1, s2 = t("weak_r1_m1000"), t("weak_r2_m2000"), t("strong_r1_m2000"), t(strong_r2)
+where = "2 GPUs, one rank each" if gpus >= 2 else f"{gpus} GPU: the two ranks share it (no second GPU here)"
+print(f"ranks on {where}; N = {particles}, {steps} steps, sine, kushner filter --filters PF, wall time of the command")
+print(f"weak:   M = 1000 on 1 rank {w1:.2f} s, M = 2000 on 2 ranks {w2:.2f} s: efficiency {w1 / w2:.3f} (goal >= 0.90)")
+print(f"strong: M = 2000 on 1 rank {s1:.2f} s, on 2 ranks {s2:.2f} s: speedup {s1 / s2:.3f} (goal >= 1.8)")
+for name, m, secs in (("1 rank, M = 1000", 1000, w1), ("1 rank, M = 2000", 2000, s1), ("2 ranks, M = 2000", 2000, s2)):
+    print(f"  {name}: {m * particles * steps / secs:.3g} particle-steps/s end to end")
+
+def numbers(path):  # every number of timeseries.csv, row by row
+    rows = [l.rstrip("\n").split(",") for l in open(path) if not l.startswith("#")]
+    return rows[0], rows[1:]
+a_dir, b_dir = os.path.join(out, "strong_r1_m2000"), os.path.join(out, strong_r2)
+header, a = numbers(os.path.join(a_dir, "timeseries.csv"))
+_, b = numbers(os.path.join(b_dir, "timeseries.csv"))
+worst = 0.0
+for ra, rb in zip(a, b):
+    assert ra[:2] == rb[:2], (ra[:2], rb[:2])
+    for x, y in zip(map(float, ra[2:]), map(float, rb[2:])):
+        if math.isnan(x) and math.isnan(y):
+            continue
+        worst = max(worst, abs(x - y) / max(abs(x), abs(y), 1e-300))
+sa, sb = (json.load(open(os.path.join(d, "summary.json"))) for d in (a_dir, b_dir))
+def flat(j, prefix=""):
+    if isinstance(j, dict):
+        for k, v in j.items():
+            if k not in ("backend", "command"):
+                yield from flat(v, prefix + "." + k)
+    elif isinstance(j, (int, float)) and not isinstance(j, bool):
+        yield prefix, float(j)
+fa, fb = dict(flat(sa)), dict(flat(sb))
+assert fa.keys() == fb.keys(), set(fa) ^ set(fb)
+for k in fa:
+    x, y = fa[k], fb[k]
+    if not (math.isnan(x) and math.isnan(y)):
+        worst = max(worst, abs(x - y) / max(abs(x), abs(y), 1e-300))
+# Line 1 is the comment with the command, whose --out differs.
+data = lambda d: open(os.path.join(d, "timeseries.csv"), "rb").read().split(b"\n", 1)[1]
+same_bytes = data(a_dir) == data(b_dir)
+print(f"R = 1 vs R = 2 (M = 2000): largest relative difference {worst:.3g} over timeseries.csv and summary.json "
+      f"(goal <= 1e-12); timeseries.csv byte-identical below its command line: {same_bytes}")
+print("backend R = 2:", json.dumps(sb["backend"]))
+sys.exit(0 if worst <= 1e-12 else 1)
+PY
+  python3 - "$out/power.csv" <<'PY' | tee -a "$out/summary.txt"
+import csv, sys
+rows = list(csv.reader(open(sys.argv[1])))[1:]
+by = {}
+for r in rows:
+    try:
+        by.setdefault(r[1].strip(), []).append((float(r[2].split()[0]), float(r[3].split()[0]), float(r[4].split()[0])))
+    except (IndexError, ValueError):
+        pass
+for gpu, v in sorted(by.items()):
+    busy = [x for x in v if x[2] > 50] or v
+    print(f"GPU {gpu}: while busy (>50% utilization, {len(busy)} samples) power {max(x[0] for x in busy):.0f} W max, "
+          f"SM clock {min(x[1] for x in busy):.0f}-{max(x[1] for x in busy):.0f} MHz")
+PY
+fi
+log "done (status $status)"
+exit $status
