@@ -45,6 +45,9 @@ KOKKOS_INLINE_FUNCTION double quiet_nan() {
 
 KOKKOS_INLINE_FUNCTION double square(double v) { return v * v; }
 
+/// +inf (Kokkos 3.4 and 4.x both keep it in Kokkos::Experimental).
+KOKKOS_INLINE_FUNCTION constexpr double infinity() { return Kokkos::Experimental::infinity<double>::value; }
+
 /// c = cos(2 pi u), s = sin(2 pi u). On a GPU CUDA's sincospi: no range reduction and one polynomial pair for
 /// both (the angle 2 pi u is never rounded); elsewhere libm's (or libmvec's) cos and sin of the rounded angle.
 KOKKOS_INLINE_FUNCTION void cos_sin_two_pi(double u, double& c, double& s) {

@@ -10,11 +10,14 @@ namespace kushner {
 
 using namespace control_detail;
 
-int run_control_command(const ControlOptions& options, const RunContext& context) {
-  validate_run_options(options.run);
-  const TimeGrid grid = make_time_grid(options.run.T, options.run.dt, options.run.output_points);
-  const OptionValues settings = filter_option_values(options);
-  with_run_model(options.run.model, options.run.model_file, options.run.sets, [&](const auto& model) {
+int run_control_command(const ControlOptions& given, const RunContext& context) {
+  validate_run_options(given.run);
+  const OptionValues settings = filter_option_values(given);
+  with_run_model(given.run.model, given.run.model_file, given.run.sets, [&](const auto& model) {
+    using Model = std::decay_t<decltype(model)>;
+    ControlOptions options = given;
+    options.run = options_for_model_time(given.run, Model::discrete_time);
+    const TimeGrid grid = make_time_grid(options.run.T, options.run.dt, options.run.output_points);
     run_control_model(model, options, settings, grid, context, /*own_kokkos=*/true);
   });
   return 0;
@@ -29,7 +32,7 @@ int run_controllers_list(bool json) {
   j["models"] = nlohmann::json::object();
   detail::for_each_model_type([&](auto* tag) {
     using Model = std::remove_pointer_t<decltype(tag)>;
-    if constexpr (!Model::discrete_time && ModelTraits<Model>::controlled && listed_once<Model>()) {
+    if constexpr (ModelTraits<Model>::controlled && listed_once<Model>()) {
       const Model model;
       nlohmann::json entry;
       entry["estimators"] = known_estimators(model);

@@ -31,5 +31,6 @@ nlohmann::json run_control_model(const Model& model, const ControlOptions& optio
 
 namespace kushner {
 KUSHNER_CONTINUOUS_MODELS(KUSHNER_EXTERN_CONTROL_COMMAND)
+KUSHNER_DISCRETE_MODELS(KUSHNER_EXTERN_CONTROL_COMMAND)
 KUSHNER_FILE_MODELS(KUSHNER_EXTERN_CONTROL_COMMAND)
 }  // namespace kushner

@@ -65,6 +65,7 @@ struct CostParameters {
     v("Q", cost.Q, "running state weight");
     v("R", cost.R, "control weight");
     v("target", cost.target, "target state x*");
+    v("D", cost.D, "estimation-error weight: (x - x_hat)'D(x - x_hat) in the running cost (Clark 1971 (2.3))");
   }
 };
 
@@ -82,11 +83,12 @@ QuadraticCost<Model::state_dim, Model::control_dim> parse_cost(const std::vector
     const auto [key, text] = split_assignment(assignment);
     ParameterSetter setter(key, text, "--cost");
     parameters.parameters(setter);
-    KUSHNER_INPUT_REQUIRE(setter.found(), "--cost " << key << ": unknown weight (known: F, Q, R, target)");
+    KUSHNER_INPUT_REQUIRE(setter.found(), "--cost " << key << ": unknown weight (known: F, Q, R, target, D)");
   }
   check_covariance("--cost F", cost.F, /*allow_singular=*/true);
   check_covariance("--cost Q", cost.Q, /*allow_singular=*/true);
   check_covariance("--cost R", cost.R, /*allow_singular=*/false);
+  check_covariance("--cost D", cost.D, /*allow_singular=*/true);
   return cost;
 }
 
@@ -120,8 +122,9 @@ MeanSe mean_se(std::size_t members, Value&& value) {
 
 /// Every controller's entry of summary.json. J_gap is J - J* against the reference where there is one (its SE
 /// the controller's: J* is a number), else the paired difference to the best controller, member by member.
+/// estimation_error: the time average of |x - x_hat|^2 over the horizon, x_hat the estimate the law reads.
 inline nlohmann::json controllers_json(const ControlReport& report, const std::optional<CostReference>& reference,
-                                       std::string& best) {
+                                       double horizon, std::string& best) {
   const auto& runs = report.controllers;
   std::size_t best_index = 0;
   std::vector<MeanSe> J(runs.size());
@@ -140,6 +143,9 @@ inline nlohmann::json controllers_json(const ControlReport& report, const std::o
     const MeanSe energy = mean_se(run.control_energy.size(), [&](std::size_t i) {
       return std::isfinite(run.cost[i]) ? run.control_energy[i] : std::nan("");
     });
+    const MeanSe squared_error = mean_se(run.squared_error.size(), [&](std::size_t i) {
+      return std::isfinite(run.cost[i]) ? run.squared_error[i] / horizon : std::nan("");
+    });
     nlohmann::json j = {{"law", run.spec.law},
                         {"estimator", run.spec.estimator},
                         {"J", J[c].mean},
@@ -150,6 +156,8 @@ inline nlohmann::json controllers_json(const ControlReport& report, const std::o
                         {"members_scored", J[c].count},
                         {"control_energy", energy.mean},
                         {"control_energy_se", energy.se},
+                        {"estimation_error", squared_error.mean},
+                        {"estimation_error_se", squared_error.se},
                         {"terminal_mean", run.terminal_mean},
                         {"truths_escaped", run.truths_escaped},
                         {"diverged", run.truths_escaped + run.estimator_diverged},
@@ -207,6 +215,11 @@ nlohmann::json run_controlled_model(const Model& model, const ControlOptions& op
   // Everything is checked before the output directory is opened.
   const std::vector<ControllerSpec> specs = select_controllers(options.controllers, model);
   const QuadraticCost<n, m> cost = parse_cost<Model>(options.cost);
+  KUSHNER_INPUT_REQUIRE(!Model::discrete_time || options.reference == "auto" || options.reference == "none",
+                        "--reference " << options.reference << ": no reference solver for discrete-time models (use none)");
+  KUSHNER_INPUT_REQUIRE(!cost.weighs_estimation() || options.reference == "auto" || options.reference == "none",
+                        "--reference " << options.reference << ": the reference solvers' cost has no estimation-error "
+                                       << "term (D = 0 only; use --reference none)");
   if (options.reference == "direct")
     KUSHNER_INPUT_REQUIRE(deterministic_problem(model),
                           "--reference direct: the problem is stochastic (process noise "
@@ -266,9 +279,12 @@ nlohmann::json run_controlled_model(const Model& model, const ControlOptions& op
     summary["dt"] = options.run.dt;
     summary["steps"] = grid.steps;
     summary["cost"] = cost_json(cost);
-    summary["cost"]["form"] = "J = (x(T)-x*)'F(x(T)-x*) + int_0^T (x-x*)'Q(x-x*) + u'Ru dt";
+    summary["cost"]["form"] = Model::discrete_time ? "J = (x[N]-x*)'F(x[N]-x*) + sum_{k<N} (x-x*)'Q(x-x*) + u'Ru + "
+                                                     "(x-x_hat)'D(x-x_hat)"
+                                                   : "J = (x(T)-x*)'F(x(T)-x*) + int_0^T (x-x*)'Q(x-x*) + u'Ru + "
+                                                     "(x-x_hat)'D(x-x_hat) dt";
     std::string best;
-    summary["controllers"] = controllers_json(report, reference, best);
+    summary["controllers"] = controllers_json(report, reference, grid.steps * grid.dt, best);
     summary["best"] = best;
     std::vector<std::string> order;
     for (const auto& spec : specs) order.push_back(spec.name);
@@ -298,13 +314,10 @@ namespace kushner {
 template <class Model>
 nlohmann::json run_control_model(const Model& model, const ControlOptions& options, const OptionValues& settings,
                                  const TimeGrid& grid, const RunContext& context, bool own_kokkos) {
-  if constexpr (Model::discrete_time) {
-    throw InputError(std::string("--model: '") + Model::name +
-                     "' is a discrete-time model; `kushner control` runs continuous-time loops");
-  } else if constexpr (!ModelTraits<Model>::controlled) {
+  if constexpr (!ModelTraits<Model>::controlled) {
     throw InputError(std::string("--model: '") + Model::name +
                      "' has no control input (controlled models: linear, sine, cubic-oscillator, car, car-taylor3, "
-                     "and a --model-file with a [control] table)");
+                     "clark-linear, clark-quintic, linear-discrete, and a --model-file with a [control] table)");
   } else {
     if constexpr (is_polynomial_model<Model>::value) {
       bool has_input = false;

@@ -38,22 +38,19 @@ void print_summary(const nlohmann::json& summary, const std::string& out) {
                                             : "CSV, JSON");
 }
 
-int run_estimation(const CompareOptions& options, const RunContext& context, const char* command) {
-  validate_run_options(options.run);
-  const TimeGrid grid = make_time_grid(options.run.T, options.run.dt, options.run.output_points);
-  const OptionValues settings = filter_option_values(options);
-  with_run_model(options.run.model, options.run.model_file, options.run.sets, [&](const auto& model) {
+int run_estimation(const CompareOptions& given, const RunContext& context) {
+  validate_run_options(given.run);
+  const OptionValues settings = filter_option_values(given);
+  with_run_model(given.run.model, given.run.model_file, given.run.sets, [&](const auto& model) {
     using Model = std::decay_t<decltype(model)>;
-    if constexpr (Model::discrete_time) {
-      throw InputError(std::string("--model: '") + Model::name + "' is a discrete-time model; `kushner " + command +
-                       "` runs the continuous-time filters");
-    } else {
-      check_compare_options<Model>(model, options, settings);  // before anything is written
-      const OutputDirectory out(options.run.out, "--out");
-      KokkosSession kokkos;
-      const nlohmann::json summary = run_compare_command(model, options, settings, grid, context, out);
-      if (options.plots && !options.run.quiet) print_summary(summary, options.run.out);
-    }
+    CompareOptions options = given;
+    options.run = options_for_model_time(given.run, Model::discrete_time);
+    const TimeGrid grid = make_time_grid(options.run.T, options.run.dt, options.run.output_points);
+    check_compare_options<Model>(model, options, settings);  // before anything is written
+    const OutputDirectory out(options.run.out, "--out");
+    KokkosSession kokkos;
+    const nlohmann::json summary = run_compare_command(model, options, settings, grid, context, out);
+    if (options.plots && !options.run.quiet) print_summary(summary, options.run.out);
   });
   return 0;
 }
@@ -65,11 +62,11 @@ int run_filter(const FilterOptions& options, const RunContext& context) {
   static_cast<FilterOptions&>(compare) = options;
   compare.trajectory_members.clear();
   compare.plots = false;
-  return run_estimation(compare, context, "filter");
+  return run_estimation(compare, context);
 }
 
 int run_compare(const CompareOptions& options, const RunContext& context) {
-  return run_estimation(options, context, "compare");
+  return run_estimation(options, context);
 }
 
 }  // namespace kushner

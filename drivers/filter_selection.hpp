@@ -6,6 +6,7 @@
 #include "engine/particle_reference.hpp"
 #include "kernels/filters/filter_list.hpp"
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -18,7 +19,13 @@ EstimatorTable estimator_table(const Model& model) {
                        {},
                        {particle_filter_name, particle_filter_unsupported<Model>()},
                        {exact_filter_name, exact_filter_unsupported(model)}};
-  for (const FilterSupport& f : filter_support(model)) table.bank.push_back({f.name, f.unsupported});
+  const std::vector<FilterSupport> own = filter_support(model);  // the filters of the model's time
+  for (const std::string& name : all_filter_names()) {           // every filter, in report order
+    const auto f = std::find_if(own.begin(), own.end(), [&](const FilterSupport& s) { return s.name == name; });
+    table.bank.push_back({name, f != own.end()        ? f->unsupported
+                                : Model::discrete_time ? "a continuous-time filter; the model is discrete-time"
+                                                       : "a discrete-time filter; the model is continuous-time"});
+  }
   return table;
 }
 

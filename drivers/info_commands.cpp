@@ -38,7 +38,7 @@ int run_filters_list(bool json) {
   std::map<std::string, nlohmann::json> options;
   detail::for_each_model_type([&](auto* tag) {
     using Model = std::remove_pointer_t<decltype(tag)>;
-    if constexpr (!Model::discrete_time && listed_once<Model>()) {
+    if constexpr (listed_once<Model>()) {  // a model's own time's filters (the other time's are never its)
       for (const auto& f : filter_support(Model{})) {
         descriptions[f.name] = f.description;
         options[f.name] = nlohmann::json::array();

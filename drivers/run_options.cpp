@@ -18,8 +18,10 @@ void add_run_options(CLI::App& app, RunOptions& o) {
   app.add_option("--set", o.sets, "model parameter, key=value (repeatable; matrices as 1,0;0,1)")
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   app.add_option("--members", o.members, "ensemble members M")->capture_default_str();
-  app.add_option("--T", o.T, "time horizon")->capture_default_str();
-  app.add_option("--dt", o.dt, "time step")->capture_default_str();
+  app.add_option("--T", o.T, "time horizon (discrete-time models: the number of steps)")->capture_default_str();
+  app.add_option("--dt", o.dt, "time step (discrete-time models: 1, the default for them)")
+      ->capture_default_str()
+      ->each([&o](const std::string&) { o.dt_given = true; });
   app.add_option("--seed", o.seed, "random seed, 0 .. 4294967295")->capture_default_str();
   app.add_option("--out", o.out, "output directory (created if missing)")->capture_default_str();
   app.add_option("--output-points", o.output_points,
@@ -54,6 +56,15 @@ void validate_run_options(const RunOptions& o) {
   KUSHNER_INPUT_REQUIRE(!o.output_points_given || o.output_points <= time_points,
                         "--output-points: must be at most T/dt + 1 = "
                             << time_points << ", the time points 0, dt, ..., T (got " << o.output_points << ")");
+}
+
+RunOptions options_for_model_time(RunOptions o, bool discrete_time) {
+  if (!discrete_time) return o;
+  KUSHNER_INPUT_REQUIRE(!o.dt_given || o.dt == 1.0,
+                        "--dt: a discrete-time model steps k = 0, 1, ..., T; --dt must be 1 (got " << o.dt << ")");
+  o.dt = 1.0;
+  validate_run_options(o);
+  return o;
 }
 
 }  // namespace kushner

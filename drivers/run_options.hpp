@@ -18,6 +18,7 @@ struct RunOptions {
   long members = 1000;
   double T = 10.0;
   double dt = 1e-3;
+  bool dt_given = false;  // --dt was given (a discrete-time model's step is 1)
   long long seed = 1;
   std::string out = "kushner-out";
   int output_points = 200;
@@ -31,5 +32,9 @@ void add_run_options(CLI::App& app, RunOptions& options);
 
 /// InputError (one line naming the option) for any value a run cannot use.
 void validate_run_options(const RunOptions& options);
+
+/// The options as a model of this time reads them: a discrete-time model steps k = 0, 1, ..., T, so dt is 1 (and
+/// --dt, if given, must say so); validated again. Continuous time: unchanged.
+RunOptions options_for_model_time(RunOptions options, bool discrete_time);
 
 }  // namespace kushner

@@ -26,11 +26,12 @@ std::string timeseries_csv(const MomentSeries& series, const RunContext& context
 
 }  // namespace
 
-int run_simulate(const RunOptions& options, const RunContext& context) {
-  validate_run_options(options);
-  const TimeGrid grid = make_time_grid(options.T, options.dt, options.output_points);
-  with_run_model(options.model, options.model_file, options.sets, [&](const auto& model) {
+int run_simulate(const RunOptions& given, const RunContext& context) {
+  validate_run_options(given);
+  with_run_model(given.model, given.model_file, given.sets, [&](const auto& model) {
     using Model = std::decay_t<decltype(model)>;
+    const RunOptions options = options_for_model_time(given, Model::discrete_time);
+    const TimeGrid grid = make_time_grid(options.T, options.dt, options.output_points);
     const OutputDirectory out(options.out, "--out");
     KokkosSession kokkos;
     with_backend(context.backend, [&](const auto& space) {

@@ -19,7 +19,9 @@ constexpr bool has_exact_reference = !std::is_void_v<exact_reference_t<Kokkos::D
 /// only at run time) noise the grid filter cannot take.
 template <class Model>
 const char* exact_filter_unsupported(const Model& model) {
-  if (!has_exact_reference<Model>) return "no exact filter, and no grid filter above dimension 2 or for discrete time";
+  if (!has_exact_reference<Model>)
+    return Model::discrete_time ? "no grid filter for this discrete-time model (scalar, bounded noises only)"
+                                : "no exact filter, and no grid filter above dimension 2";
   if constexpr (ModelTraits<Model>::runtime_checked)
     if (!model.model_facts().axis_aligned_noise) return "the grid filter needs axis-aligned noise (b b^T diagonal)";
   return nullptr;
@@ -48,6 +50,10 @@ class ExactReferenceEstimator final : public ReferenceEstimator<typename ExecSpa
       return fields("benes", "Benes closed form (exact)");
     else if constexpr (std::is_same_v<Reference, GridFilter<ExecSpace, Model>>)
       return fields("grid", "point-mass grid filter (Fokker-Planck prediction, Bayes update)");
+    else if constexpr (std::is_same_v<Reference, DiscreteGridFilter<ExecSpace, Model>>)
+      return {{"kind", std::string("grid")},
+              {"note", std::string("point-mass Bayes filter with exact cell masses (noise CDFs)")},
+              {"cells", static_cast<long>(reference_.cells())}};
     else
       return fields("kalman", "Kalman filter of the Euler-Maruyama discretization (exact for it)");
   }

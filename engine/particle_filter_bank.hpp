@@ -66,7 +66,6 @@ class ParticleFilterBank {
  public:
   using MemSpace = typename ExecSpace::memory_space;
   static constexpr int state_dim = Model::state_dim;
-  static_assert(!Model::discrete_time, "ParticleFilterBank: continuous-time models only (dy increments)");
 
   ParticleFilterBank(const ExecSpace& space, const Model& model, int num_members, int num_particles, Seed seed,
                      ResamplingScheme scheme = ResamplingScheme::systematic, double ess_threshold = 0.5)
@@ -271,9 +270,10 @@ class ParticleFilterBank {
                                      << Model::obs_dim << ")");
   }
 
-  /// (R R^T)^{-1} at t.
+  /// (R R^T)^{-1} at t; the identity for a discrete-time model (its weights read z itself).
   Mat<Model::obs_dim, Model::obs_dim> observation_precision(double t) const {
     constexpr int p = Model::obs_dim;
+    if constexpr (Model::discrete_time) return Mat<p, p>::identity();
     const Mat<p, p> r = model_.observation_noise(t);
     Mat<p, p> root;
     KUSHNER_REQUIRE(cholesky(r * transpose(r), root),

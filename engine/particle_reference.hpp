@@ -25,7 +25,6 @@ constexpr int max_particle_filter_dim = 4;
 /// Why the particle filter cannot run Model, or nullptr.
 template <class Model>
 constexpr const char* particle_filter_unsupported() {
-  if (Model::discrete_time) return "discrete-time model";
   if (Model::state_dim > max_particle_filter_dim) return "state dimension above 4";
   return nullptr;
 }

@@ -1,7 +1,7 @@
 #pragma once
 // The bank of truths: initial states, and one step of every member in one kernel. Continuous-time models
 // take an Euler-Maruyama step and produce the observation increment dy over the step; discrete-time models
-// take x[k+1] = F(k, x[k], u) + w[k] and produce z[k+1] = H x[k+1] + v[k+1] in the same bank.
+// take x[k+1] = F(k, x[k], u) + w[k] and produce z[k+1] = h(k+1, x[k+1]) + v[k+1] in the same bank.
 #include "core/errors.hpp"
 #include "kernels/bank.hpp"
 #include "kernels/for_each_member.hpp"
@@ -82,26 +82,50 @@ struct EulerMaruyamaTruthStep {
   }
 };
 
-/// One step of a discrete-time model: x <- F(k, x, u) + w, z = H(k+1, x) + v, noises sampled by the model
-/// from uniforms (inverse CDF), so bounded non-Gaussian laws are exact.
+/// The draws of one discrete-time noise vector of dimension Q at (member, step): Q standard normals (Gaussian
+/// noise) and one uniform (bounded noise by its inverse CDF), from distinct Philox blocks of `key`. A model's
+/// process_noise / observation_noise_sample takes what its law needs of them.
+template <int Q>
+struct DiscreteNoiseDraws {
+  Vec<Q> normals;
+  double uniform;
+};
+template <int Q>
+KOKKOS_INLINE_FUNCTION DiscreteNoiseDraws<Q> discrete_noise_draws(const RngKey& key, std::uint32_t member,
+                                                                  std::uint32_t step) {
+  DiscreteNoiseDraws<Q> d;
+  d.normals = normal_vector<Q>(key, member, 0, step);  // blocks 0 .. ceil(Q/2) - 1
+  double unused;
+  uniform_pair(key, Counter{member, 0, step, static_cast<std::uint32_t>(Q)}, d.uniform, unused);
+  return d;
+}
+
+/// One step k of a discrete-time model: x <- F(k, x, u) + w[k], then dy <- z[k+1] = h(k+1, x) + v[k+1] (the
+/// field keeps the continuous step's name: every bank reads the step's observation from it). t = k, dt = 1.
 template <class Model, class MemSpace>
 struct DiscreteTruthStep {
   Model model;
-  BankVector<MemSpace> x, z;
+  BankVector<MemSpace> x, dy;
+  double t, dt;
   Seed seed;
   std::uint32_t step;
 
-  KOKKOS_INLINE_FUNCTION void operator()(const int member) const {
-    constexpr int n = Model::state_dim, p = Model::obs_dim;
-    const typename Model::Control u = Model::Control::zero();
-    const Vec<n> w = model.process_noise(uniform_vector<n>(RngKey{seed, Stream::process_noise}, member, 0, step));
-    const Vec<n> next = model.transition(static_cast<int>(step), load<n>(x, member), u) + w;
-    const Vec<p> v =
-        model.observation_noise_sample(uniform_vector<p>(RngKey{seed, Stream::observation_noise}, member, 0, step));
+  KOKKOS_INLINE_FUNCTION void operator()(const int member) const { step_member(member, Model::Control::zero()); }
+
+  KOKKOS_INLINE_FUNCTION void step_member(const int member, const typename Model::Control& u) const {
+    constexpr int n = Model::state_dim, p = Model::obs_dim, q = Model::noise_dim;
+    const auto w = discrete_noise_draws<q>(RngKey{seed, Stream::process_noise}, member, step);
+    const auto v = discrete_noise_draws<p>(RngKey{seed, Stream::observation_noise}, member, step);
+    const Vec<n> next = model.transition(t, load<n>(x, member), u) + model.process_noise(w.normals, w.uniform);
     store(x, member, next);
-    store(z, member, model.observation(static_cast<int>(step) + 1, next) + v);
+    store(dy, member, model.observation(t + 1.0, next) + model.observation_noise_sample(v.normals, v.uniform));
   }
 };
+
+/// The truth step of Model's time: Euler-Maruyama, or the discrete-time transition.
+template <class Model, class MemSpace>
+using TruthStep = std::conditional_t<Model::discrete_time, DiscreteTruthStep<Model, MemSpace>,
+                                     EulerMaruyamaTruthStep<Model, MemSpace>>;
 
 /// Advances every member of the bank by one step; `observations` receives dy (continuous time) or z[k+1]
 /// (discrete time). No fence: the caller fences before reading results on the host.
@@ -113,13 +137,8 @@ void simulate_truth_step(const ExecSpace& space, const Model& model, const BankV
                   "x has " << x.extent(1) << " columns, " << Model::name << " has state_dim " << Model::state_dim);
   KUSHNER_REQUIRE(observations.extent_int(1) == Model::obs_dim && observations.extent(0) == x.extent(0),
                   "observation bank has shape (" << observations.extent(0) << ", " << observations.extent(1) << ")");
-  if constexpr (Model::discrete_time) {
-    parallel_for_members("kushner::discrete_truth_step", space, x.extent(0),
-                         DiscreteTruthStep<Model, MemSpace>{model, x, observations, seed, step});
-  } else {
-    parallel_for_members("kushner::euler_maruyama_truth_step", space, x.extent(0),
-                         EulerMaruyamaTruthStep<Model, MemSpace>{model, x, observations, t, dt, seed, step});
-  }
+  parallel_for_members("kushner::truth_step", space, x.extent(0),
+                       TruthStep<Model, MemSpace>{model, x, observations, t, dt, seed, step});
 }
 
 }  // namespace kushner

@@ -20,6 +20,26 @@ struct BoundedPowerNoise {
     if (k % 2 == 1) return 0.0;
     return math::pow(bound, k) * (rho + 1.0) / (rho + 1.0 + k);
   }
+  /// P(Y <= y), exact (the grid filter's cell masses).
+  KOKKOS_INLINE_FUNCTION double cdf(double y) const {
+    if (y <= -bound) return 0.0;
+    if (y >= bound) return 1.0;
+    const double half_mass = 0.5 * math::pow(math::fabs(y) / bound, rho + 1.0);
+    return y < 0.0 ? 0.5 - half_mass : 0.5 + half_mass;
+  }
+  /// The density at y: zero outside (-c, c).
+  KOKKOS_INLINE_FUNCTION double density(double y) const {
+    const double a = math::fabs(y);
+    if (a >= bound) return 0.0;
+    return rho == 0.0 ? 0.5 / bound : 0.5 * (rho + 1.0) / bound * math::pow(a / bound, rho);
+  }
+  /// log density(y); -inf outside (-c, c) and, for rho > 0, at 0.
+  KOKKOS_INLINE_FUNCTION double log_density(double y) const {
+    const double d = density(y);
+    return d > 0.0 ? math::log(d) : -math::infinity();
+  }
+  /// The largest log density: at the bounds for rho > 0, everywhere inside for rho = 0.
+  KOKKOS_INLINE_FUNCTION double max_log_density() const { return math::log(0.5 * (rho + 1.0) / bound); }
 };
 
 }  // namespace kushner

@@ -1,14 +1,16 @@
 #pragma once
 // Every model type kushner runs, one line each: adding a model is its header, its #include below and one
 // line in a list. The registry (models/registry.hpp) reads the lists for `--model NAME`, and CMake reads this
-// file to compile the `filter`/`compare` commands for every model of KUSHNER_CONTINUOUS_MODELS and
-// KUSHNER_FILE_MODELS (drivers/CMakeLists.txt), so neither keeps a copy. One entry per line, spelled
+// file to compile the `filter`, `compare` and `control` commands for every model of the three lists
+// (drivers/CMakeLists.txt), so neither keeps a copy. One entry per line, spelled
 // `MODEL(Type)`, `DISCRETE_MODEL(Type)` or `FILE_MODEL(Type)`: CMake matches those words.
 #include "models/benes_model.hpp"
 #include "models/car_model.hpp"
 #include "models/clark_linear_model.hpp"
+#include "models/clark_quintic_model.hpp"
 #include "models/cubic_oscillator_model.hpp"
 #include "models/cubic_sensor_model.hpp"
+#include "models/linear_discrete_model.hpp"
 #include "models/linear_model.hpp"
 #include "models/ou_model.hpp"
 #include "models/pendulum_model.hpp"
@@ -36,8 +38,11 @@
   MODEL(PendulumModel)                   \
   MODEL(RangeBearingModel)
 
-/// Discrete-time models named by `--model` (simulated; the filter commands refuse them for now).
-#define KUSHNER_DISCRETE_MODELS(DISCRETE_MODEL) DISCRETE_MODEL(ClarkLinearModel)
+/// Discrete-time models named by `--model`.
+#define KUSHNER_DISCRETE_MODELS(DISCRETE_MODEL) \
+  DISCRETE_MODEL(ClarkLinearModel)              \
+  DISCRETE_MODEL(ClarkQuinticModel)             \
+  DISCRETE_MODEL(LinearDiscreteModel)
 
 /// The polynomial models of `--model-file`, one type per state dimension.
 #define KUSHNER_FILE_MODELS(FILE_MODEL) \

@@ -169,4 +169,27 @@ KOKKOS_INLINE_FUNCTION SdcDrift<Model::state_dim> drift_sdc(const Model& model, 
   }
 }
 
+namespace detail {
+template <class Model, class = void>
+struct declares_linear_transition : std::false_type {};
+template <class Model>
+struct declares_linear_transition<Model, std::enable_if_t<Model::linear_transition>> : std::true_type {};
+
+template <class Model, class = void>
+struct has_bounded_noises : std::false_type {};
+template <class Model>
+struct has_bounded_noises<Model, std::void_t<decltype(std::declval<const Model&>().w.bound),
+                                             decltype(std::declval<const Model&>().v.bound)>> : std::true_type {};
+}  // namespace detail
+
+/// Capabilities of a discrete-time model (x[k+1] = F(k, x, u) + w, z = h(k, x) + v), as its filters see them.
+template <class Model>
+struct DiscreteModelTraits {
+  /// F(k, x, u) = A(k) x + F(k, 0, u), A = transition_jacobian(k, .) constant in x.
+  static constexpr bool linear = detail::declares_linear_transition<Model>::value;
+  static constexpr bool linear_observation = detail::declares_linear_observation<Model>::value;
+  /// Scalar w and v of Clark's bounded power-law family (members w, v: models/clark_noises.hpp).
+  static constexpr bool bounded_noises = detail::has_bounded_noises<Model>::value;
+};
+
 }  // namespace kushner

@@ -90,6 +90,7 @@ const Example examples[] = {
     {"basin-car-controller", reproduce_basin_car_controller, true, 0.3, 2e-3, 1000, 0},
     {"sunahara-ex1", reproduce_sunahara_ex1, true, 10.0, 2e-3, 100, 1024},
     {"sunahara-ex2", reproduce_sunahara_ex2, true, 5.0, 2e-3, 100, 1024},
+    {"clark-table-2.1", reproduce_clark_table_2_1, true, 100.0, 1.0, 500, 1024},
 };
 
 const Example& find_example(const std::string& name) {

@@ -76,5 +76,7 @@ ExampleResult reproduce_basin_car_controller(const ReproduceSettings& settings, 
                                              const OutputDirectory& out);
 ExampleResult reproduce_basin_terpolymer(const ReproduceSettings& settings, const RunContext& context,
                                          const OutputDirectory& out);
+ExampleResult reproduce_clark_table_2_1(const ReproduceSettings& settings, const RunContext& context,
+                                        const OutputDirectory& out);
 
 }  // namespace kushner

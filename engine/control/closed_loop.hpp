@@ -89,7 +89,7 @@ class ControlLoop {
   /// Step k over [k dt, (k + 1) dt]; `record`: (k + 1) dt is an output time.
   void step(long k, double dt, bool record) {
     typename K::Step kernel;
-    kernel.truth = EulerMaruyamaTruthStep<Model, MemSpace>{
+    kernel.truth = TruthStep<Model, MemSpace>{
         model_, truths_.state(), truths_.observations(), k * dt, dt, seed_, static_cast<std::uint32_t>(k)};
     kernel.model = model_;
     kernel.truth_status = truth_status_;
@@ -119,6 +119,9 @@ class ControlLoop {
 
   /// Each member's control energy, the integral of |u|^2 dt so far.
   std::vector<double> member_control_energy() const { return host_column(totals_, loop_control_energy); }
+
+  /// Each member's sum over steps of |x - x_hat|^2 dt so far (x_hat: the estimate the law reads).
+  std::vector<double> member_squared_error() const { return host_column(totals_, loop_squared_error); }
 
   /// Each member's running cost so far.
   std::vector<double> member_running_cost() const { return host_column(totals_, loop_running_cost); }

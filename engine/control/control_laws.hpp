@@ -2,7 +2,8 @@
 // The gain laws a controller can use, by name, and how each is made for a model and a cost on the run's grid:
 // the one place a law name becomes a ControlLaw (the command line lists and checks names from law_list()).
 //   NONE   no control: the plant left alone, the baseline;
-//   LQR    the affine LQR of the model linearized at the origin (engine/control/gain_laws.hpp);
+//   LQR    the affine LQR of the model linearized at the origin (engine/control/gain_laws.hpp); for a
+//          discrete-time model the discrete Riccati recursion (Clark's Riccati controller);
 //   ASRE   Cimen & Banks' approximating sequence of Riccati equations on the nominal path (gain_laws.hpp);
 //   POLY3  Basin's polynomial regulator along its nominal path, the two-point problem solved by the sweep and by
 //          Newton (poly3_regulator.hpp);
@@ -43,7 +44,7 @@ inline std::vector<LawInfo> law_list() {
 /// Taylor model).
 template <class Model>
 constexpr bool poly3_designable() {
-  if constexpr (!ModelTraits<Model>::controlled)
+  if constexpr (!ModelTraits<Model>::controlled || Model::discrete_time)
     return false;
   else if constexpr (detail::has_design_polynomial<Model>::value)
     return true;
@@ -55,13 +56,15 @@ constexpr bool poly3_designable() {
 /// HJB's chain: dimension 1 or 2, one control.
 template <class Model>
 constexpr bool hjb_solvable() {
-  return Model::state_dim <= 2 && Model::control_dim == 1;
+  return !Model::discrete_time && Model::state_dim <= 2 && Model::control_dim == 1;
 }
 
 /// Why `law` cannot control Model, or nullptr.
 template <class Model>
 const char* law_unsupported(const std::string& law) {
   if (!ModelTraits<Model>::controlled) return "the model has no control input";
+  if (Model::discrete_time && law != "NONE" && law != "LQR")
+    return "discrete time: the Riccati controller (LQR) and NONE only";
   if (law == "ASRE" && !ModelTraits<Model>::sdc) return "the model has no factorization f = A(x) x + b";
   if (law == "POLY3" && !poly3_designable<Model>()) return "the drift is not a polynomial of degree <= 3";
   if (law == "HJB" && !hjb_solvable<Model>()) return "the Markov chain approximation needs dimension 1-2, one control";
@@ -87,7 +90,17 @@ MadeLaw<Model, MemSpace> make_law(const std::string& name, const Model& model,
     made.fields = {{"law", std::string("none")}};
     return made;
   }
-  if constexpr (ModelTraits<Model>::controlled) {
+  if constexpr (ModelTraits<Model>::controlled && Model::discrete_time) {
+    if (name == "LQR") {
+      const auto solution = discrete_lqr_solution(model, cost, grid.steps);
+      KUSHNER_INPUT_REQUIRE(solution.finite, "LQR: the Riccati recursion escapes to infinity over the horizon");
+      made.law = affine_law<n, m, MemSpace>(solution.gains);
+      made.fields = {{"law", std::string("LQR")},
+                     {"form", std::string("discrete Riccati recursion (Clark 1971 (2.5)-(2.7))")},
+                     {"linearized_at", std::string("origin")}};
+      return made;
+    }
+  } else if constexpr (ModelTraits<Model>::controlled) {
     if (name == "LQR") {
       const auto solution = lqr_solution(model, cost, grid.steps, grid.dt, Vec<n>::zero());
       KUSHNER_INPUT_REQUIRE(solution.finite, "LQR: the Riccati equation escapes to infinity over [0, T]");

@@ -32,6 +32,7 @@ struct ControllerRun {
   ControllerSpec spec;
   std::vector<double> cost;            // per member: J (NaN where the truth escaped)
   std::vector<double> control_energy;  // per member: integral of |u|^2 dt
+  std::vector<double> squared_error;   // per member: integral of |x - x_hat|^2 dt (x_hat: the law's estimate)
   std::vector<double> terminal_mean;   // mean x(T) over members whose truth did not escape
   long truths_escaped = 0, estimator_diverged = 0;
   Fields law_fields, estimator_fields;
@@ -149,6 +150,7 @@ ControllerRun run_controller(const ExecSpace& space, const Model& model, long me
   space.fence();
   run.cost = collective::gather(loop.member_costs());
   run.control_energy = collective::gather(loop.member_control_energy());
+  run.squared_error = collective::gather(loop.member_squared_error());
   run.terminal_mean = ensemble_moments(space, loop.truths().state()).mean;
   run.truths_escaped = loop.truths_escaped();
   run.estimator_diverged = loop.estimator_diverged();

@@ -29,6 +29,9 @@ struct CostReference {
 /// Whether the model's truths are deterministic: no process noise at the start's mean and a fixed start.
 template <class Model>
 bool deterministic_problem(const Model& model) {
+  if constexpr (Model::discrete_time) {
+    return false;  // the discrete-time models have noise of their own law (no direct solver for them)
+  } else {
   const auto G = model.diffusion(0.0, model.x0_mean);
   for (int i = 0; i < Model::state_dim; ++i) {
     for (int j = 0; j < Model::noise_dim; ++j)
@@ -37,6 +40,7 @@ bool deterministic_problem(const Model& model) {
       if (model.x0_cov(i, j) != 0.0) return false;
   }
   return true;
+  }
 }
 
 /// The reference `kind` asks for ("auto": direct for a deterministic problem, else hjb where it applies; "none"),
@@ -47,9 +51,17 @@ std::optional<CostReference> cost_reference(const Model& model,
                                             const TimeGrid& grid, const std::string& kind) {
   constexpr int n = Model::state_dim;
   const bool deterministic = deterministic_problem(model);
+  const bool estimation_weight = cost.weighs_estimation();
+  KUSHNER_INPUT_REQUIRE(!estimation_weight || kind == "auto" || kind == "none",
+                        "--reference " << kind << ": the reference solvers' cost has no estimation-error term (D = 0 "
+                                       << "only; use --reference none)");
+  if (estimation_weight || (Model::discrete_time && kind == "auto")) return std::nullopt;
+  KUSHNER_INPUT_REQUIRE(!Model::discrete_time || kind == "none",
+                        "--reference " << kind << ": no reference solver for discrete-time models (use none)");
   std::string chosen = kind;
   if (kind == "auto") chosen = deterministic ? "direct" : hjb_solvable<Model>() ? "hjb" : "none";
   if (chosen == "none") return std::nullopt;
+  if constexpr (!Model::discrete_time) {
   if (chosen == "direct") {
     KUSHNER_INPUT_REQUIRE(deterministic,
                           "--reference direct: the problem is stochastic (process noise or a random "
@@ -62,6 +74,7 @@ std::optional<CostReference> cost_reference(const Model& model,
                           {"gradient_norm", optimum.gradient_norm},
                           {"converged", static_cast<long>(optimum.converged)},
                           {"reason", optimum.reason}}};
+  }
   }
   KUSHNER_INPUT_REQUIRE(chosen == "hjb", "--reference: unknown kind '" << kind << "' (auto, hjb, direct, none)");
   if constexpr (hjb_solvable<Model>()) {

@@ -9,6 +9,7 @@
 //         to get x^[i]; x^[-1] = x0. The iteration runs on the nominal (noise-free) path from the prior mean;
 //         each member then applies the converged time-varying gains to its own estimate (separation).
 #include "core/errors.hpp"
+#include "engine/control/discrete_riccati.hpp"
 #include "engine/control/riccati.hpp"
 #include "models/model_traits.hpp"
 
@@ -44,6 +45,23 @@ RiccatiSolution<Model::state_dim, Model::control_dim> lqr_solution(const Model& 
     const Mat<n, n> A = model.drift_jacobian(t, x_lin, u0);
     return AffineCoefficients<n, m>{A, model.drift(t, x_lin, u0) - A * x_lin, model.control_input(t)};
   });
+}
+
+/// The Riccati controller of a discrete-time model linearized at the origin: A = dF/dx(k, 0), a = F(k, 0, 0),
+/// B = control_input(k), W = Cov w (seed 003 (2.5)-(2.7); (3.12) for the perturbation loop's linear part).
+template <class Model>
+RiccatiSolution<Model::state_dim, Model::control_dim> discrete_lqr_solution(const Model& model,
+                                                                            const ModelCost<Model>& cost, long steps) {
+  constexpr int n = Model::state_dim, m = Model::control_dim;
+  const Vec<n> origin = Vec<n>::zero();
+  return solve_discrete_lqr<n, m>(
+      steps, cost,
+      [&](long k) {
+        const double t = static_cast<double>(k);
+        return AffineCoefficients<n, m>{model.transition_jacobian(t, origin),
+                                        model.transition(t, origin, Model::Control::zero()), model.control_input(t)};
+      },
+      [&](long k) { return model.process_noise_covariance(static_cast<double>(k)); });
 }
 
 /// The ASRE iteration's result: the converged gains, the nominal path they produce, and how it converged.

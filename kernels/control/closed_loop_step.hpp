@@ -1,7 +1,8 @@
 #pragma once
 // One step of one controller's closed loop, for every member in one kernel: the law reads the member's
 // estimate at t, the cost accrues over [t, t + dt] at the left end (the rule the reference solvers use too),
-// the truth takes its Euler-Maruyama step driven by that control, and the estimator (a filter of the bank, or
+// the truth takes its Euler-Maruyama step (a discrete-time model: its transition) driven by that control, and
+// the estimator (a filter of the bank, or
 // none: the state itself, or an estimator outside the kernel such as the particle filter, which then steps on
 // the `control` this kernel stores) takes its step with the truth's dy and the known input B u. The filters are
 // the model's compile-time list with at most one enabled, so each model's closed loop is one kernel whatever
@@ -20,7 +21,8 @@ namespace kushner {
 enum LoopColumn : int {
   loop_running_cost = 0,    // sum over steps of running(x, u) dt
   loop_control_energy = 1,  // sum over steps of |u|^2 dt
-  num_loop_columns = 2,
+  loop_squared_error = 2,   // sum over steps of |x - x_hat|^2 dt, x_hat the estimate the law reads
+  num_loop_columns = 3,
 };
 
 /// Where the law's estimate comes from.
@@ -29,7 +31,7 @@ enum class EstimateSource { state, bank_filter, outside };
 template <class Model, class MemSpace, class... Filters>
 struct ClosedLoopStep {
   static constexpr int n = Model::state_dim, p = Model::obs_dim, m = Model::control_dim;
-  EulerMaruyamaTruthStep<Model, MemSpace> truth;
+  TruthStep<Model, MemSpace> truth;
   Model model;
   BankScalar<Status, MemSpace> truth_status;
   FilterSlots<MemSpace, Filters...> slots;  // at most one enabled: the estimator when source == bank_filter
@@ -53,8 +55,9 @@ struct ClosedLoopStep {
     if (source == EstimateSource::bank_filter)
       (read_estimate(static_cast<const FilterSlot<Filters, MemSpace>&>(slots), member, estimate), ...);
     const Vec<m> u = law(step, estimate);
-    totals(member, loop_running_cost) += cost.running(x, u) * truth.dt;
+    totals(member, loop_running_cost) += (cost.running(x, u) + cost.estimation_penalty(x, estimate)) * truth.dt;
     totals(member, loop_control_energy) += cost.control_energy(u) * truth.dt;
+    totals(member, loop_squared_error) += dot(x - estimate, x - estimate) * truth.dt;
     store(control, member, u);
     truth.step_member(member, u);
     const Vec<n> next = load<n>(truth.x, member);
@@ -67,7 +70,8 @@ struct ClosedLoopStep {
     if (source != EstimateSource::bank_filter) return;
     const Mat<p, p> R = model.observation_noise(truth.t);
     const StepInput<p> in{truth.t, truth.dt, dy, R * transpose(R)};
-    const Vec<n> shift = model.control_input(truth.t) * u * truth.dt;
+    // The known input: B u dt of the Euler step, or a discrete step's B u (kernels/filters/filter_slot.hpp).
+    const Vec<n> shift = model.control_input(truth.t) * u * (Model::discrete_time ? 1.0 : truth.dt);
     (advance(static_cast<const FilterSlot<Filters, MemSpace>&>(slots), model, member, in, next, record, shift), ...);
   }
 

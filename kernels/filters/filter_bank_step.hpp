@@ -1,7 +1,7 @@
 #pragma once
 // The bank's kernels. One step is one pass over the members: each member's truth takes its Euler-Maruyama
-// step (producing dy), then every selected filter takes its step with that same dy and is scored against
-// the new truth. The filters are a compile-time list (no virtual calls); unselected ones are skipped by a
+// step (producing dy; a discrete-time model: its transition, producing z[k+1]), then every selected filter
+// takes its step with that same observation and is scored against the new truth. The filters are a compile-time list (no virtual calls); unselected ones are skipped by a
 // flag that is the same for every member.
 #include "kernels/filters/filter_slot.hpp"
 #include "kernels/simulate_truth.hpp"
@@ -20,7 +20,7 @@ template <class Model, class TruthModel, class MemSpace, class... Filters>
 struct FilterBankStep {
   static_assert(TruthModel::state_dim == Model::state_dim && TruthModel::obs_dim == Model::obs_dim,
                 "FilterBankStep: the truths' model and the filters' model must have the same dimensions");
-  EulerMaruyamaTruthStep<TruthModel, MemSpace> truth;
+  TruthStep<TruthModel, MemSpace> truth;
   Model model;
   BankScalar<Status, MemSpace> truth_status;  // non_finite once a truth escaped: not filtered, not scored
   FilterSlots<MemSpace, Filters...> slots;

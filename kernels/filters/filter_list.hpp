@@ -8,18 +8,22 @@
 // own requirements).
 #include "kernels/filters/asre_filter.hpp"
 #include "kernels/filters/bilinear_filter.hpp"
+#include "kernels/filters/clark_approximate_filter.hpp"
 #include "kernels/filters/detchmendy_sridhar_filter.hpp"
+#include "kernels/filters/discrete_kalman_filter.hpp"
 #include "kernels/filters/ensemble_kalman_bucy_filter.hpp"
 #include "kernels/filters/extended_kalman_filter.hpp"
 #include "kernels/filters/filter_protocol.hpp"
 #include "kernels/filters/kalman_bucy_filter.hpp"
 #include "kernels/filters/linearized_kalman_bucy_filter.hpp"
 #include "kernels/filters/mixed_filter.hpp"
+#include "kernels/filters/moment_filter.hpp"
 #include "kernels/filters/polynomial_filter.hpp"
 #include "kernels/filters/quasi_linear_filter.hpp"
 #include "kernels/filters/second_order_filter.hpp"
 #include "kernels/filters/unscented_kalman_filter.hpp"
 
+#include "models/clark_linear_model.hpp"
 #include "models/linear_model.hpp"
 
 #include <algorithm>
@@ -32,7 +36,7 @@
 namespace kushner {
 
 template <class Model, class MemSpace>
-using AllFilters =
+using ContinuousTimeFilters =
     std::tuple<KalmanBucyFilter<Model, MemSpace>, ExtendedKalmanFilter<Model, MemSpace>,
                DetchmendySridharFilter<Model, MemSpace>, SecondOrderFilter<Model, MemSpace>,
                SchwartzBassFilter<Model, MemSpace>, QuasiLinearFilter<Model, MemSpace>,
@@ -40,6 +44,18 @@ using AllFilters =
                Polynomial4Filter<Model, MemSpace>, BilinearFilter<Model, MemSpace>, MixedFilter<Model, MemSpace>,
                AsreFilter<Model, MemSpace>, LinearizedKalmanBucyFilter<Model, MemSpace>,
                EnsembleKalmanBucyFilter<Model, MemSpace>, StochasticEnsembleKalmanBucyFilter<Model, MemSpace>>;
+
+template <class Model, class MemSpace>
+using DiscreteTimeFilters =
+    std::tuple<KalmanFilter<Model, MemSpace>, InformationFilter<Model, MemSpace>, ExtendedKalmanFilterD<Model, MemSpace>,
+               MomentFilter<Model, MemSpace>, ClarkMidpointFilter<Model, MemSpace>,
+               ClarkLeastSquaresFilter<Model, MemSpace>, ClarkStraightLineFilter<Model, MemSpace>,
+               ClarkHyperbolicFilter<Model, MemSpace>>;
+
+/// The filters of Model's time (continuous or discrete): a model's filters are never compiled for the other time.
+template <class Model, class MemSpace>
+using AllFilters = std::conditional_t<Model::discrete_time, DiscreteTimeFilters<Model, MemSpace>,
+                                      ContinuousTimeFilters<Model, MemSpace>>;
 
 namespace detail {
 template <class Tuple>
@@ -94,18 +110,25 @@ std::vector<std::string> supported_filters(const Model& model) {
   return names;
 }
 
+/// Calls f(static_cast<Filter*>(nullptr)) for every filter of both times, continuous first: what does not depend
+/// on the model (names, options, randomness) is read from these instances.
+template <class F>
+void for_each_named_filter(F&& f) {
+  for_each_filter_type<LinearModel<1>, Kokkos::HostSpace>(f);
+  for_each_filter_type<ClarkLinearModel, Kokkos::HostSpace>(f);
+}
+
 /// Every filter name, in report order (names do not depend on the model).
 inline std::vector<std::string> all_filter_names() {
   std::vector<std::string> names;
-  for_each_filter_type<LinearModel<1>, Kokkos::HostSpace>(
-      [&](auto* tag) { names.push_back(std::remove_pointer_t<decltype(tag)>::name); });
+  for_each_named_filter([&](auto* tag) { names.push_back(std::remove_pointer_t<decltype(tag)>::name); });
   return names;
 }
 
 /// The names of the filters that draw random numbers (filter_randomized), in report order.
 inline std::vector<std::string> randomized_filter_names() {
   std::vector<std::string> names;
-  for_each_filter_type<LinearModel<1>, Kokkos::HostSpace>([&](auto* tag) {
+  for_each_named_filter([&](auto* tag) {
     using Filter = std::remove_pointer_t<decltype(tag)>;
     if (filter_randomized<Filter>()) names.push_back(Filter::name);
   });
@@ -115,7 +138,7 @@ inline std::vector<std::string> randomized_filter_names() {
 /// Every filter's options, in report order (they do not depend on the model).
 inline std::vector<OptionSpec> all_filter_options() {
   std::vector<OptionSpec> options;
-  for_each_filter_type<LinearModel<1>, Kokkos::HostSpace>([&](auto* tag) {
+  for_each_named_filter([&](auto* tag) {
     for (auto& o : filter_options<std::remove_pointer_t<decltype(tag)>>())
       if (std::none_of(options.begin(), options.end(), [&](const OptionSpec& s) { return s.name == o.name; }))
         options.push_back(std::move(o));  // a setting two filters share is declared once

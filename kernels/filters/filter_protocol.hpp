@@ -6,6 +6,9 @@
 //   static Filter create(const OptionValues&, const Model&, long members);
 //   KOKKOS_INLINE_FUNCTION Status step(const Model&, int member, const StepInput<p>&, Vec<n>& m, Mat<n, n>& P) const;
 //
+// (a discrete-time filter's step also takes `const Vec<n>& known_input`, a closed loop's B u[k], which enters its
+// prediction before the update with z[k+1]; the filter lists of the two times are kernels/filters/filter_list.hpp's)
+//
 // and, where it needs them, these optional parts, which the engine, the command line, `kushner filters` and the
 // summary discover from the filter list (kernels/filters/filter_list.hpp) without naming the filter:
 //

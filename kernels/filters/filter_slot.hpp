@@ -69,7 +69,8 @@ KOKKOS_INLINE_FUNCTION void mark_unscored(const Slot& s, int member) {
 /// P not positive semidefinite), then the scores against the new truth x. A diverged member keeps its last
 /// good m, P and is not updated again. In a closed loop, `control_shift` = B(t) u dt, the known input's part of
 /// the mean's Euler step: every filter's prediction is m + (a + B u) dt with P unchanged by a known additive
-/// input (kernels/filters/filter_step.hpp), so adding it after the filter's own step is that step exactly.
+/// input (kernels/filters/filter_step.hpp), so adding it after the filter's own step is that step exactly. A
+/// discrete-time filter predicts before it updates with z[k+1], so it takes B u[k] into its step's prediction.
 template <class Model, class Filter, class MemSpace>
 KOKKOS_INLINE_FUNCTION void advance(const FilterSlot<Filter, MemSpace>& s, const Model& model, int member,
                                     const StepInput<Model::obs_dim>& in, const Vec<Model::state_dim>& x, bool record,
@@ -82,9 +83,14 @@ KOKKOS_INLINE_FUNCTION void advance(const FilterSlot<Filter, MemSpace>& s, const
   }
   Vec<n> m = load<n>(s.m, member);
   Mat<n, n> P = load_symmetric<n>(s.P, member);
-  Status status = s.filter.step(model, member, in, m, P);
-  m += control_shift;
-  if constexpr (detail::has_known_input<Filter, n>::value) s.filter.apply_known_input(member, control_shift);
+  Status status;
+  if constexpr (Model::discrete_time) {
+    status = s.filter.step(model, member, in, m, P, control_shift);
+  } else {
+    status = s.filter.step(model, member, in, m, P);
+    m += control_shift;
+    if constexpr (detail::has_known_input<Filter, n>::value) s.filter.apply_known_input(member, control_shift);
+  }
   if (status == Status::ok && !(all_finite(m) && all_finite(P))) status = Status::non_finite;
   Mat<n, n> L;
   Definiteness definiteness = Definiteness::indefinite;

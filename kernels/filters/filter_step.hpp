@@ -22,7 +22,8 @@ namespace kushner {
 /// Pivots within this fraction of the largest variance count as zero (core/linear_algebra.hpp).
 constexpr double covariance_tolerance = 1e-10;
 
-/// What one step of one member gives every filter.
+/// What one step of one member gives every filter. A discrete-time model's step k: t = k, dt = 1, dy = z[k+1],
+/// V = Cov v.
 template <int P>
 struct StepInput {
   double t, dt;

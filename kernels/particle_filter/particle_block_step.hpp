@@ -79,12 +79,12 @@ KUSHNER_SAME_CODE_FOR_ALL_CALLERS void particle_block_host(const ParticleStepDat
     lw[j] = lj;
     l[j] = lj;
   }
-  double m = -positive_infinity();
+  double m = -math::infinity();
   KUSHNER_SIMD_REDUCTION(max : m)
   for (int j = 0; j < count; ++j) m = l[j] > m ? l[j] : m;
 
   WeightedMoments<n> w = WeightedMoments<n>::empty();
-  if (m > -positive_infinity()) {
+  if (m > -math::infinity()) {
     const Vec<n> ref = load<n>(d.reference, member);
     w.max_log_weight = m;
     KUSHNER_SIMD

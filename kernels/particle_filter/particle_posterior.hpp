@@ -83,7 +83,7 @@ struct MonteCarloStandardError {
   KOKKOS_INLINE_FUNCTION void operator()(const int member) const {
     for (int i = 0; i < N; ++i)
       se(member, i) = ess(member) > 0.0 ? math::sqrt(covariance(member, packed_index(N, i, i)) / ess(member))
-                                        : positive_infinity() - positive_infinity();  // NaN: member diverged
+                                        : math::infinity() - math::infinity();  // NaN: member diverged
   }
 };
 

@@ -80,7 +80,7 @@ template <int N, class Team, class Scratch, class Resum>
 KOKKOS_INLINE_FUNCTION void team_moments_at_shift(const Team& team, const Scratch& buffer, double shift,
                                                   WeightedMoments<N>& w, const Resum& resum) {
   team_sum(team, buffer, w);
-  if (!(w.max_log_weight > -positive_infinity())) return;  // every particle of the chunk has weight zero
+  if (!(w.max_log_weight > -math::infinity())) return;  // every particle of the chunk has weight zero
   const double gap = w.max_log_weight - shift;
   if (!(gap >= -team_max_shift_gap && gap <= team_max_shift_gap)) {
     shift = w.max_log_weight;

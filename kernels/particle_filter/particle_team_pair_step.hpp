@@ -39,7 +39,7 @@ struct ParticleTeamPairStep {
       for (int s = 0; s < 2; ++s) {
         const Vec<p> dy = load<p>(s == 0 ? d.dy : next.dy, member);
         vinv_dy[s] = precision(s) * dy;
-        bound += log_weight_bound(dy, vinv_dy[s], d.dt);
+        bound += log_weight_bound(d.model, dy, vinv_dy[s], d.dt);
         shift[s] = bound;
       }
       step_particles(member, c, ref, vinv_dy, shift, w);
@@ -68,7 +68,7 @@ struct ParticleTeamPairStep {
     constexpr int B = 2 * device_pairs_per_batch;
     constexpr int K = particle_draw_dim<Model, false>;
     const double log_normalizer = d.log_normalizer(member);
-    double top[2] = {-positive_infinity(), -positive_infinity()};
+    double top[2] = {-math::infinity(), -math::infinity()};
     const double* const xm = &d.x(0, member, 0);
     const double* const lwm = &d.log_weight(0, member);
     double* const xo = &next.x(0, member, 0);

@@ -31,7 +31,7 @@ struct ParticleTeamStep {
       } else {
         const Vec<p> dy = load<p>(d.dy, member);
         const Vec<p> vinv_dy = d.observation_precision * dy;
-        shift = log_weight_bound(dy, vinv_dy, d.dt);
+        shift = log_weight_bound(d.model, dy, vinv_dy, d.dt);
         step_particles<false>(member, c, ref, vinv_dy, shift, w);
       }
     }
@@ -51,7 +51,7 @@ struct ParticleTeamStep {
     constexpr int B = 2 * device_pairs_per_batch;  // particles per batch
     constexpr int K = particle_draw_dim<Model, Initialize>;
     const double log_normalizer = Initialize ? 0.0 : d.log_normalizer(member);
-    double top = -positive_infinity();
+    double top = -math::infinity();
     // The member's columns as pointers: one 64-bit address computation per thread, not per access.
     double* const xm = &d.x(0, member, 0);
     double* const lwm = &d.log_weight(0, member);

@@ -3,7 +3,9 @@
 // observations as in Bain & Crisan 2009, ch. 9): propagate with the model's Euler-Maruyama step (or its exact
 // transition), then multiply the weight by the likelihood of the member's observation increment,
 //   log g(dy | x) = h(x)^T V^{-1} dy - (dt / 2) h(x)^T V^{-1} h(x) + const,   V = R R^T,
-// which is -|dy - h dt|^2_{(V dt)^{-1}} / 2 up to a constant of the member. Every step kernel (the host's
+// which is -|dy - h dt|^2_{(V dt)^{-1}} / 2 up to a constant of the member. A discrete-time model's particle
+// takes x <- F(k, x, u) + w (the model's process_noise from the particle's draws) and the weight the density of
+// v at z[k+1] - h(k+1, x) (zero outside a bounded noise's support). Every step kernel (the host's
 // block kernel, the GPU's one-step and fused two-step team kernels) calls update_particle, with the draws
 // of particle_draws.hpp.
 #include "core/linear_algebra.hpp"
@@ -66,7 +68,7 @@ template <class Model, bool Initialize>
 constexpr int particle_draw_dim = Initialize ? Model::state_dim : Model::noise_dim;
 
 template <class Model, bool Initialize>
-constexpr bool draws_uniform = !Initialize && has_exact_transition<Model>::value;
+constexpr bool draws_uniform = !Initialize && (Model::discrete_time || has_exact_transition<Model>::value);
 
 /// The key and step of the particles' draws: their initial states, or step d.step.
 template <bool Initialize, class Model, class MemSpace>
@@ -113,7 +115,8 @@ KOKKOS_INLINE_FUNCTION typename Model::Control particle_control(const ParticleSt
 
 /// Moves one particle (x in, x out) over [t, t + dt] with its draws (normals z, uniform u) and returns its new
 /// log-weight, normalized by the member's previous log-normalizer; -inf for a particle that left the finite
-/// numbers. `precision` is V^{-1} at t; `control` is the member's (particle_control).
+/// numbers. `precision` is V^{-1} at t; `control` is the member's (particle_control). A discrete-time model's
+/// precision is the identity, so `vinv_dy` is z[k+1] itself.
 template <bool Initialize, class Model, class MemSpace>
 KOKKOS_INLINE_FUNCTION double update_particle(const ParticleStepData<Model, MemSpace>& d, double t,
                                               const Mat<Model::obs_dim, Model::obs_dim>& precision,
@@ -125,6 +128,13 @@ KOKKOS_INLINE_FUNCTION double update_particle(const ParticleStepData<Model, MemS
   if constexpr (Initialize) {
     x = d.initial_mean + d.initial_root * z;
     return 0.0;
+  } else if constexpr (Model::discrete_time) {
+    x = d.model.transition(t, x, control) + d.model.process_noise(z, u);
+    const double l = log_weight - log_normalizer + d.model.observation_log_density(vinv_dy - d.model.observation(t + 1.0, x));
+    bool finite = math::is_finite(l);
+    KUSHNER_UNROLL_FULLY
+    for (int i = 0; i < n; ++i) finite = finite & math::is_finite(x[i]);
+    return finite ? l : -math::infinity();
   } else {
     if constexpr (has_exact_transition<Model>::value) {
       x = d.model.sample_exact_transition(t, x, d.dt, z, u);
@@ -137,16 +147,21 @@ KOKKOS_INLINE_FUNCTION double update_particle(const ParticleStepData<Model, MemS
     bool finite = math::is_finite(l);
     KUSHNER_UNROLL_FULLY
     for (int i = 0; i < n; ++i) finite = finite & math::is_finite(x[i]);  // `&`: no branch, so GCC can vectorize
-    return finite ? l : -positive_infinity();
+    return finite ? l : -math::infinity();
   }
 }
 
 /// The largest log-likelihood increment any particle can get from an increment dy: h.a - (dt/2) h^T V^-1 h
 /// with a = V^-1 dy is largest at h = V a / dt, where it is dy^T V^-1 dy / (2 dt). The previous log-weights
 /// are normalized (each <= 0), so this bounds every new log-weight from above; 0 where it is not finite.
-template <int P>
-KOKKOS_INLINE_FUNCTION double log_weight_bound(const Vec<P>& dy, const Vec<P>& vinv_dy, double dt) {
-  const double bound = 0.5 * dot(dy, vinv_dy) / dt;
+/// A discrete-time model's bound is the largest log density of v.
+template <class Model, int P>
+KOKKOS_INLINE_FUNCTION double log_weight_bound(const Model& model, const Vec<P>& dy, const Vec<P>& vinv_dy, double dt) {
+  double bound;
+  if constexpr (Model::discrete_time)
+    bound = model.observation_max_log_density();
+  else
+    bound = 0.5 * dot(dy, vinv_dy) / dt;
   return math::is_finite(bound) ? bound : 0.0;
 }
 

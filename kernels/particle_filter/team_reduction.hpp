@@ -51,7 +51,7 @@ struct MomentValuesReducer {
     }
   }
   KOKKOS_INLINE_FUNCTION void init(value_type& x) const {
-    x.v[0] = -positive_infinity();
+    x.v[0] = -math::infinity();
     for (int k = 1; k < Values; ++k) x.v[k] = 0.0;
   }
   KOKKOS_INLINE_FUNCTION value_type& reference() const { return *value; }

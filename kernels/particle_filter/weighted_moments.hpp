@@ -11,9 +11,6 @@
 
 namespace kushner {
 
-/// +inf (Kokkos 3.4 and 4.x both keep it in Kokkos::Experimental).
-KOKKOS_INLINE_FUNCTION constexpr double positive_infinity() { return Kokkos::Experimental::infinity<double>::value; }
-
 template <int N>
 struct WeightedMoments {
   static constexpr int packed = packed_size(N);  // entries of a packed N x N symmetric matrix
@@ -28,7 +25,7 @@ struct WeightedMoments {
 
   KOKKOS_INLINE_FUNCTION static WeightedMoments empty() {
     WeightedMoments w;
-    w.max_log_weight = -positive_infinity();
+    w.max_log_weight = -math::infinity();
     w.sum_weight = w.sum_weight_sq = 0.0;
     w.sum_dx = Vec<N>::zero();
     w.sum_dxdx = Vec<packed>::zero();
@@ -38,7 +35,7 @@ struct WeightedMoments {
   /// Adds one particle with log-weight l at offset dx from the reference; l = -inf adds nothing.
   KOKKOS_INLINE_FUNCTION void add(double l, const Vec<N>& dx) {
     if (!(l > max_log_weight)) {
-      if (!(l > -positive_infinity())) return;
+      if (!(l > -math::infinity())) return;
       accumulate(math::exp(l - max_log_weight), dx);
       return;
     }
@@ -49,7 +46,7 @@ struct WeightedMoments {
 
   /// This set followed by `other`; the order matters in the last bits only.
   KOKKOS_INLINE_FUNCTION void merge(const WeightedMoments& other) {
-    if (!(other.max_log_weight > -positive_infinity())) return;
+    if (!(other.max_log_weight > -math::infinity())) return;
     if (other.max_log_weight == max_log_weight) {  // the GPU's blocks share one shift: no exp (exp(0) = 1 exactly)
       add_scaled(other, 1.0);
     } else if (other.max_log_weight > max_log_weight) {

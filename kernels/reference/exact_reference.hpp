@@ -1,13 +1,16 @@
 #pragma once
 // Which exact (or grid) reference a model has, for `--filters EXACT`: the Kalman filter of the particle
 // filter's discretization for linear models, the Benes closed form for the Benes model, the grid filter for
-// the other models of state dimension 1 or 2 with axis-aligned noise (sine, cubic oscillator, OU). `void`
-// where there is none (dimension 3, discrete time).
+// the other models of state dimension 1 or 2 with axis-aligned noise (sine, cubic oscillator, OU), the discrete
+// grid filter for scalar discrete-time models with bounded noises (Clark's). `void` where there is none
+// (dimension 3; other discrete-time models: on the Gaussian linear one KF itself is exact).
 #include "kernels/reference/benes_filter.hpp"
+#include "kernels/reference/discrete_grid_filter.hpp"
 #include "kernels/reference/grid_filter.hpp"
 #include "kernels/reference/kalman_bucy_reference.hpp"
 #include "models/benes_model.hpp"
 #include "models/linear_model.hpp"
+#include "models/model_traits.hpp"
 
 #include <type_traits>
 
@@ -17,6 +20,11 @@ template <class ExecSpace, class Model, class = void>
 struct exact_reference {
   using type = std::conditional_t<!Model::discrete_time && (Model::state_dim == 1 || Model::state_dim == 2),
                                   GridFilter<ExecSpace, Model>, void>;
+};
+template <class ExecSpace, class Model>
+struct exact_reference<ExecSpace, Model, std::enable_if_t<Model::discrete_time>> {
+  using type = std::conditional_t<Model::state_dim == 1 && DiscreteModelTraits<Model>::bounded_noises,
+                                  DiscreteGridFilter<ExecSpace, Model>, void>;
 };
 template <class ExecSpace, int N>
 struct exact_reference<ExecSpace, LinearModel<N>> {

@@ -26,8 +26,6 @@ expect_refused "filter BILIN does not support model 'cubic-oscillator' (drift is
 known=$("$kushner" filters --json | python3 -c 'import json, sys; print(", ".join(f["name"] for f in json.load(sys.stdin)))')
 expect_refused "--filters: unknown filter 'NOPE' (known: $known, PF, EXACT, or all)" filter --model sine --filters EKF,NOPE
 expect_refused "--filters: empty name in 'EKF,,SOF'" filter --model sine --filters EKF,,SOF
-expect_refused "--model: 'clark-linear' is a discrete-time model; \`kushner filter\` runs the continuous-time filters" \
-  filter --model clark-linear
 expect_refused "--qlf-expectations: model 'benes' has no closed-form Gaussian expectations (use cubature)" \
   filter --model benes --filters QLF --qlf-expectations closed
 expect_refused "--qlf-expectations: cubature is limited to state_dim <= 3 (model 'terpolymer' has 10)" \

@@ -1,0 +1,78 @@
+#!/usr/bin/env bash
+# Discrete-time models through the command line (issue 15): `filter`/`compare` run the discrete filters and
+# references, time is the step index (dt = 1), and bad input gets one line and exit 2 with nothing written.
+set -euo pipefail
+kushner=$1
+source "$(dirname "$0")/lib.sh"
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+expect_refused() {  # expect_refused "exact message" args...
+  local expected=$1; shift
+  run_kushner "$work/r" "$@" --out "$work/refused"
+  [ "$rc" -eq 2 ] || fail "exit $rc (want 2) for: $*; stderr: $(cat "$work/r.err")"
+  [ "$(wc -l <"$work/r.err")" -eq 1 ] || fail "stderr is not one line for: $*: $(cat "$work/r.err")"
+  [ "$(cat "$work/r.err")" = "kushner: error: $expected" ] || fail "message for: $*: $(cat "$work/r.err") (want: $expected)"
+  [ ! -e "$work/refused" ] || fail "a refused run created its output directory: $*"
+  echo "ok: $expected"
+}
+
+expect_refused "--dt: a discrete-time model steps k = 0, 1, ..., T; --dt must be 1 (got 0.5)" \
+  filter --model clark-linear --dt 0.5
+expect_refused "--T: must be a whole number of --dt steps (T/dt = 10.5)" filter --model clark-linear --T 10.5
+expect_refused "rho_w, rho_v: must be at least 0 (got -1, 0)" filter --model clark-linear --set rho_w=-1
+expect_refused "bound_w, bound_v: must be positive (got 1, 0)" filter --model clark-linear --set bound_v=0
+expect_refused "R: R R^T must be positive definite" filter --model linear-discrete --set 'R=1,0;0,0'
+expect_refused "filter KF does not support model 'clark-quintic' (transition is not linear)" \
+  filter --model clark-quintic --filters KF
+expect_refused "filter MOM does not support model 'linear-discrete' (state or observation is not scalar)" \
+  filter --model linear-discrete --filters MOM
+expect_refused "filter EKF does not support model 'clark-linear' (a continuous-time filter; the model is discrete-time)" \
+  filter --model clark-linear --filters EKF
+expect_refused "filter KF does not support model 'sine' (a discrete-time filter; the model is continuous-time)" \
+  filter --model sine --filters KF
+expect_refused "filter EXACT does not support model 'linear-discrete' (no grid filter for this discrete-time model (scalar, bounded noises only))" \
+  filter --model linear-discrete --filters KF,EXACT
+expect_refused "--mom-order: must be in 1 .. 14 (got 20)" filter --model clark-linear --filters MOM --mom-order 20
+
+# A run: every discrete filter, the particle filter and the grid Bayes filter on clark-linear; steps of 1.
+"$kushner" filter --model clark-linear --filters all,EXACT --members 300 --particles 512 --T 20 --seed 4 \
+  --out "$work/run" --quiet
+python3 - "$work/run" <<'PY' || fail "clark-linear run"
+import json, sys
+s = json.load(open(sys.argv[1] + "/summary.json"))
+assert s["dt"] == 1 and s["steps"] == 20, (s["dt"], s["steps"])
+order = s["filter_order"]
+assert order == ["KF", "KF-INF", "EKF-D", "MOM", "MOM-MID", "MOM-LS", "MOM-LINE", "MOM-HYP", "PF", "EXACT"], order
+f = s["filters"]
+for name in order:
+    assert f[name]["diverged"] == 0, (name, f[name])
+# KF = KF-INF = EKF-D on a linear model; the Bayes filter (grid) and the particle filter below KF; MOM between.
+assert abs(f["KF"]["rmse_truth"] - f["KF-INF"]["rmse_truth"]) < 1e-10 and f["KF"]["rmse_truth"] == f["EKF-D"]["rmse_truth"]
+assert f["EXACT"]["rmse_truth"] < f["MOM"]["rmse_truth"] < f["KF"]["rmse_truth"], [f[n]["rmse_truth"] for n in ("EXACT", "MOM", "KF")]
+assert abs(f["PF"]["rmse_truth"] - f["EXACT"]["rmse_truth"]) < 0.02, (f["PF"]["rmse_truth"], f["EXACT"]["rmse_truth"])
+assert f["EXACT"]["rmse_ref"] < 0.05, f["EXACT"]["rmse_ref"]
+assert f["MOM"]["order"] == 4 and s["reference"]["name"] == "PF"
+print("clark-linear rmse_truth:", {n: round(f[n]["rmse_truth"], 4) for n in order})
+PY
+echo "ok: clark-linear filter run"
+
+# The nonlinear plant: EKF-D, MOM refused (nonlinear), the grid and the particle filter; the Gaussian linear model.
+"$kushner" filter --model clark-quintic --filters EKF-D,PF,EXACT --members 100 --particles 256 --T 10 --out "$work/quintic" --quiet
+"$kushner" filter --model linear-discrete --filters all --members 100 --particles 256 --T 10 --out "$work/gauss" --quiet
+python3 - "$work/quintic" "$work/gauss" <<'PY' || fail "clark-quintic or linear-discrete run"
+import json, sys
+q = json.load(open(sys.argv[1] + "/summary.json"))
+assert q["filter_order"] == ["EKF-D", "PF", "EXACT"] and all(f["diverged"] == 0 for f in q["filters"].values())
+g = json.load(open(sys.argv[2] + "/summary.json"))
+assert g["filter_order"] == ["KF", "KF-INF", "EKF-D", "PF"], g["filter_order"]
+# On the Gaussian linear model KF is the exact filter: the particle filter lands on it.
+assert g["filters"]["KF"]["rmse_ref"] < 0.1 * g["filters"]["KF"]["rmse_truth"], g["filters"]["KF"]
+PY
+echo "ok: clark-quintic and linear-discrete runs"
+
+# simulate takes the same time rule.
+"$kushner" simulate --model clark-linear --members 50 --T 5 --out "$work/sim" --quiet
+python3 -c 'import json, sys; s = json.load(open(sys.argv[1])); assert s["steps"] == 5 and s["dt"] == 1' "$work/sim/summary.json" \
+  || fail "simulate on a discrete-time model"
+echo "ok: simulate"

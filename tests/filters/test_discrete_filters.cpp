@@ -1,0 +1,237 @@
+// The discrete-time filters and references (issue 15), each against something independent:
+//   KF on the Gaussian linear model = the exact posterior computed in one batch (joint Gaussian conditioning of
+//   x[K] on z[1..K], Eigen) to 1e-12; KF-INF = KF to 1e-10; EKF-D = KF on a linear model;
+//   MOM of growing order approaches the exact grid Bayes filter on clark-linear, and the grid converges in its
+//   cell count; the particle filter approaches the grid like N^-1/2; Clark's posterior bounds always hold the
+//   truth; on Clark's bounded noises the Bayes filter beats KF by many standard errors.
+#include "engine/filter_bank.hpp"
+#include "engine/particle_filter_bank.hpp"
+#include "kernels/reference/discrete_grid_filter.hpp"
+#include "models/clark_linear_model.hpp"
+#include "models/linear_discrete_model.hpp"
+
+#include <Eigen/Dense>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+namespace kushner {
+namespace {
+
+using Space = Kokkos::DefaultExecutionSpace;
+using Host = Kokkos::HostSpace;
+
+template <class View>
+auto host_copy(const View& v) {
+  return Kokkos::create_mirror_view_and_copy(Host(), v);
+}
+
+/// The bank's m (member, i) and P (member, packed) of `filter`, on the host.
+template <class Bank>
+std::pair<Kokkos::View<double**, Kokkos::LayoutLeft, Host>, Kokkos::View<double**, Kokkos::LayoutLeft, Host>>
+filter_state(const Bank& bank, const char* filter) {
+  Kokkos::View<double**, Kokkos::LayoutLeft, Host> m, P;
+  bank.with_slot(filter, [&](const auto& slot) {
+    m = Kokkos::View<double**, Kokkos::LayoutLeft, Host>("m", slot.m.extent(0), slot.m.extent(1));
+    P = Kokkos::View<double**, Kokkos::LayoutLeft, Host>("P", slot.P.extent(0), slot.P.extent(1));
+    Kokkos::deep_copy(m, host_copy(slot.m));
+    Kokkos::deep_copy(P, host_copy(slot.P));
+  });
+  return {m, P};
+}
+
+TEST(DiscreteKalmanFilter, EqualsBatchGaussianConditioningOnTheLinearModel) {
+  LinearDiscreteModel model;
+  model.H = Mat<2, 2>{{{1.0, 0.5}, {0.0, 0.0}}};  // a rank-one observation: the second row sees nothing
+  model.R = Mat<2, 2>{{{0.4, 0.0}, {0.1, 0.3}}};
+  constexpr int members = 6, steps = 25;
+  FilterBank<Space, LinearDiscreteModel> bank(Space(), model, model, members, 11, {"KF", "KF-INF", "EKF-D"});
+  std::vector<Kokkos::View<double**, Kokkos::LayoutLeft, Host>> z;
+  for (int k = 0; k < steps; ++k) {
+    bank.step(k, 1.0, false);
+    Space().fence();
+    z.push_back(Kokkos::View<double**, Kokkos::LayoutLeft, Host>("z", members, 2));
+    Kokkos::deep_copy(z.back(), host_copy(bank.truths().observations()));
+  }
+  const auto [m_kf, P_kf] = filter_state(bank, "KF");
+  const auto [m_inf, P_inf] = filter_state(bank, "KF-INF");
+  const auto [m_ekf, P_ekf] = filter_state(bank, "EKF-D");
+
+  // The joint Gaussian of (x[K], z[1..K]) from x[0] ~ N(m0, P0): Cov(x_i, x_j) = F^(i-j) Cov(x_j, x_j) for i >= j.
+  using Matrix = Eigen::MatrixXd;
+  const Matrix F = to_eigen(model.F), H = to_eigen(model.H), Q = to_eigen(model.G * transpose(model.G)),
+               V = to_eigen(model.R * transpose(model.R));
+  std::vector<Matrix> mean(steps + 1), cov(steps + 1);
+  mean[0] = to_eigen(model.prior_mean);
+  cov[0] = to_eigen(model.prior_cov);
+  for (int k = 1; k <= steps; ++k) {
+    mean[k] = F * mean[k - 1];
+    cov[k] = F * cov[k - 1] * F.transpose() + Q;
+  }
+  const auto cross = [&](int i, int j) {  // Cov(x_i, x_j)
+    Matrix c = i >= j ? cov[j] : cov[i];
+    for (int s = 0; s < std::abs(i - j); ++s) c = i >= j ? Matrix(F * c) : Matrix(c * F.transpose());
+    return c;
+  };
+  Matrix Szz(2 * steps, 2 * steps), Sxz(2, 2 * steps);
+  for (int i = 1; i <= steps; ++i) {
+    for (int j = 1; j <= steps; ++j)
+      Szz.block(2 * (i - 1), 2 * (j - 1), 2, 2) = H * cross(i, j) * H.transpose() + (i == j ? V : Matrix::Zero(2, 2));
+    Sxz.block(0, 2 * (i - 1), 2, 2) = cross(steps, i) * H.transpose();
+  }
+  const Eigen::LDLT<Matrix> solver(Szz);  // H is rank one: Szz stays positive definite through V
+  const Matrix posterior_cov = cov[steps] - Sxz * solver.solve(Sxz.transpose());
+  for (int member = 0; member < members; ++member) {
+    Eigen::VectorXd innovation(2 * steps);
+    for (int k = 1; k <= steps; ++k)
+      innovation.segment(2 * (k - 1), 2) = Eigen::Vector2d(z[k - 1](member, 0), z[k - 1](member, 1)) - H * mean[k];
+    const Eigen::VectorXd posterior_mean = mean[steps] + Sxz * solver.solve(innovation);
+    for (int i = 0; i < 2; ++i) {
+      EXPECT_NEAR(m_kf(member, i), posterior_mean(i), 1e-12 * (1.0 + std::abs(posterior_mean(i)))) << member;
+      EXPECT_NEAR(m_inf(member, i), m_kf(member, i), 1e-10 * (1.0 + std::abs(m_kf(member, i))));
+      EXPECT_EQ(m_ekf(member, i), m_kf(member, i));
+    }
+    for (int i = 0; i < 2; ++i)
+      for (int j = i; j < 2; ++j) {
+        const int packed = packed_index(2, i, j);
+        EXPECT_NEAR(P_kf(member, packed), posterior_cov(i, j), 1e-12 * (1.0 + std::abs(posterior_cov(i, j))));
+        EXPECT_NEAR(P_inf(member, packed), P_kf(member, packed), 1e-10 * (1.0 + std::abs(P_kf(member, packed))));
+      }
+  }
+  // Power: a filter that assumes another transition is off by far more than the tolerance.
+  LinearDiscreteModel wrong = model;
+  wrong.F(0, 0) *= 1.05;
+  FilterBank<Space, LinearDiscreteModel> off(Space(), model, wrong, members, 11, {"KF"});
+  for (int k = 0; k < steps; ++k) off.step(k, 1.0, false);
+  Space().fence();
+  const auto [m_off, P_off] = filter_state(off, "KF");
+  double largest = 0.0;
+  for (int member = 0; member < members; ++member) largest = std::max(largest, std::abs(m_off(member, 0) - m_kf(member, 0)));
+  EXPECT_GT(largest, 1e-4);
+}
+
+/// Means (member) of a clark-linear grid filter of `cells` cells and of the bank's filter `filter` (with
+/// `settings`) after `steps` steps, on the same truths (same seed).
+struct ClarkRun {
+  std::vector<double> grid_mean, filter_mean, truth;
+  long filter_diverged = 0;
+};
+ClarkRun run_clark(int members, int steps, int cells, const char* filter, const OptionValues& settings = {}) {
+  const ClarkLinearModel model;
+  FilterBank<Space, ClarkLinearModel> bank(Space(), model, model, members, 5, {filter}, settings);
+  DiscreteGridFilter<Space, ClarkLinearModel> grid(Space(), model, members, cells);
+  for (int k = 0; k < steps; ++k) {
+    bank.step(k, 1.0, false);
+    grid.step(k, 1.0, bank.truths().observations());
+  }
+  Space().fence();
+  ClarkRun run;
+  const auto g = host_copy(grid.posterior_mean());
+  const auto x = host_copy(bank.truths().state());
+  const auto gs = host_copy(grid.status());
+  const auto [m, P] = filter_state(bank, filter);
+  bank.with_slot(filter, [&](const auto& slot) {
+    const auto status = host_copy(slot.status);
+    for (int i = 0; i < members; ++i) run.filter_diverged += status(i) != Status::ok;
+  });
+  for (int i = 0; i < members; ++i) {
+    EXPECT_EQ(gs(i), Status::ok);
+    run.grid_mean.push_back(g(i, 0));
+    run.filter_mean.push_back(m(i, 0));
+    run.truth.push_back(x(i, 0));
+  }
+  return run;
+}
+
+double rms_difference(const std::vector<double>& a, const std::vector<double>& b) {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) sum += (a[i] - b[i]) * (a[i] - b[i]);
+  return std::sqrt(sum / a.size());
+}
+
+TEST(MomentFilter, ApproachesTheGridBayesFilterAsItsOrderGrows) {
+  constexpr int members = 200, steps = 12;
+  // The grid's own error: 400 against 3200 cells.
+  const ClarkRun fine = run_clark(members, steps, 3200, "KF");
+  const ClarkRun coarse = run_clark(members, steps, 400, "KF");
+  const double grid_error = rms_difference(fine.grid_mean, coarse.grid_mean);
+  EXPECT_LT(grid_error, 1e-3);
+  std::vector<double> error;
+  for (int order : {2, 4, 8, 12}) {
+    OptionValues settings;
+    settings.set("mom_order", static_cast<long>(order));
+    const ClarkRun run = run_clark(members, steps, 3200, "MOM", settings);
+    EXPECT_EQ(run.filter_diverged, 0) << "order " << order;
+    error.push_back(rms_difference(run.filter_mean, run.grid_mean));
+    std::printf("MOM order %2d: rms |m - m_grid| = %.3g (grid 400 vs 3200 cells: %.3g)\n", order, error.back(),
+                grid_error);
+  }
+  for (std::size_t i = 1; i < error.size(); ++i) EXPECT_LT(error[i], error[i - 1]);
+  EXPECT_LT(error.back(), 0.25 * error.front());
+}
+
+TEST(DiscreteParticleFilter, ApproachesTheGridLikeOneOverRootN) {
+  constexpr int members = 200, steps = 8;
+  const ClarkLinearModel model;
+  std::vector<double> error;
+  for (int particles : {256, 1024, 4096}) {
+    FilterBank<Space, ClarkLinearModel> bank(Space(), model, model, members, 5, {"KF"});
+    DiscreteGridFilter<Space, ClarkLinearModel> grid(Space(), model, members, 3200);
+    ParticleFilterBank<Space, ClarkLinearModel> pf(Space(), model, members, particles, 5);
+    for (int k = 0; k < steps; ++k) {
+      bank.step(k, 1.0, false);
+      grid.step(k, 1.0, bank.truths().observations());
+      pf.step(k, 1.0, bank.truths().observations());
+    }
+    Space().fence();
+    const auto g = host_copy(grid.posterior_mean());
+    const auto p = host_copy(pf.posterior_mean());
+    const auto status = host_copy(pf.status());
+    double sum = 0.0;
+    for (int i = 0; i < members; ++i) {
+      EXPECT_EQ(status(i), Status::ok);
+      sum += (p(i, 0) - g(i, 0)) * (p(i, 0) - g(i, 0));
+    }
+    error.push_back(std::sqrt(sum / members));
+    std::printf("PF N = %5d: rms |m_pf - m_grid| = %.3g\n", particles, error.back());
+  }
+  // Quadrupling N halves the error; 200 members measure each rms to about 5%.
+  for (std::size_t i = 1; i < error.size(); ++i) {
+    EXPECT_GT(error[i - 1] / error[i], 1.6);
+    EXPECT_LT(error[i - 1] / error[i], 2.5);
+  }
+}
+
+TEST(ClarkBounds, TheSupportAlwaysHoldsTheTruth) {
+  const ClarkLinearModel model;
+  constexpr int members = 500, steps = 30;
+  FilterBank<Space, ClarkLinearModel> bank(Space(), model, model, members, 3, {"MOM-MID"});
+  for (int k = 0; k < steps; ++k) {
+    bank.step(k, 1.0, false);
+    Space().fence();
+    const auto x = host_copy(bank.truths().state());
+    const auto [m, P] = filter_state(bank, "MOM-MID");
+    for (int i = 0; i < members; ++i)  // the support is m -+ sqrt(3 P)
+      ASSERT_LE(std::abs(x(i, 0) - m(i, 0)), std::sqrt(3.0 * P(i, 0)) * (1 + 1e-12)) << "member " << i << " step " << k;
+  }
+}
+
+TEST(ClarkLinear, TheBayesFilterBeatsTheKalmanFilter) {
+  constexpr int members = 400, steps = 40;
+  const ClarkRun run = run_clark(members, steps, 800, "KF");
+  double kf = 0.0, bayes = 0.0, kf2 = 0.0, bayes2 = 0.0, diff2 = 0.0;
+  for (int i = 0; i < members; ++i) {
+    const double a = std::pow(run.filter_mean[i] - run.truth[i], 2), b = std::pow(run.grid_mean[i] - run.truth[i], 2);
+    kf += a, bayes += b, kf2 += a * a, bayes2 += b * b, diff2 += (a - b) * (a - b);
+  }
+  kf /= members, bayes /= members;
+  const double se = std::sqrt((diff2 / members - (kf - bayes) * (kf - bayes)) / members);  // paired
+  std::printf("squared error at k = %d: KF %.4f, Bayes (grid) %.4f, difference %.4f +- %.4f\n", steps, kf, bayes,
+              kf - bayes, se);
+  EXPECT_NEAR(kf, 0.2394, 5.0 * std::sqrt((kf2 / members - kf * kf) / members));  // KF's steady-state variance
+  EXPECT_GT(kf - bayes, 5.0 * se);
+}
+
+}  // namespace
+}  // namespace kushner
