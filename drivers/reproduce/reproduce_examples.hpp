@@ -51,6 +51,8 @@ struct ExampleResult {
   std::string notes;              // markdown: what ran, with which sizes and readings
   nlohmann::json summary;         // one run: its compare summary; several: {"runs": {name: summary}}
   std::vector<std::string> runs;  // subdirectories holding the runs' artefacts; empty: the output directory itself
+  // false: the example wrote no compare run (no timeseries.csv for the figures), so report.md is the table alone
+  bool compare_report = true;
 };
 
 /// The terminal values of `trajectories.csv` (as `kushner compare` writes it) for `member`: (series, component)
@@ -76,5 +78,7 @@ ExampleResult reproduce_basin_car_controller(const ReproduceSettings& settings, 
                                              const OutputDirectory& out);
 ExampleResult reproduce_basin_terpolymer(const ReproduceSettings& settings, const RunContext& context,
                                          const OutputDirectory& out);
+ExampleResult reproduce_tarushkin_attitude(const ReproduceSettings& settings, const RunContext& context,
+                                           const OutputDirectory& out);
 
 }  // namespace kushner
