@@ -31,12 +31,12 @@ struct AttitudeOscillationModel {
   static constexpr const char* description =
       "Tarushkin 1972 §4: attitude angles as 15 Fourier coefficients, one reference vector (geomagnetic field)";
 
-  double orbit_rate = 2.0 * math::pi / 5400.0;  // rad/s: a 90-minute circular orbit
+  double orbit_rate = 2.0 * math::pi / 5400.0;   // rad/s: a 90-minute circular orbit
   double omega = 2.0 * 2.0 * math::pi / 5400.0;  // rad/s: the oscillations' known frequency
   double inclination = 51.6 * math::pi / 180.0;  // rad
-  double u0 = 0.0;                                // rad: argument of latitude at t = 0
-  double sigma = 0.01;                            // sensor noise per component, in units of the field
-  Vec<state_dim> d0 = Vec<state_dim>::zero();     // the zero approximation, rad
+  double u0 = 0.0;                               // rad: argument of latitude at t = 0
+  double sigma = 0.01;                           // sensor noise per component, in units of the field
+  Vec<state_dim> d0 = Vec<state_dim>::zero();    // the zero approximation, rad
 
   template <class Visitor>
   void parameters(Visitor&& v) {

@@ -120,8 +120,8 @@ TEST(LeastSquares, FirstDeterminedStepIsTheLeastSquaresEstimate) {  // (4.12): n
 
 /// The attitude model's samples every dt over [0, T], stacked `per_block` to a block as in (3.1), (4.7)-(4.8),
 /// observing the coefficient corrections x with the sensor's noise.
-std::vector<ObservationBlock> attitude_blocks(const AttitudeOscillationModel& model, double T, double dt,
-                                              int per_block, const VectorXd& x, std::mt19937_64& rng) {
+std::vector<ObservationBlock> attitude_blocks(const AttitudeOscillationModel& model, double T, double dt, int per_block,
+                                              const VectorXd& x, std::mt19937_64& rng) {
   std::normal_distribution<double> normal;
   std::vector<ObservationBlock> blocks;
   const int samples = static_cast<int>(std::lround(T / dt));
@@ -170,7 +170,13 @@ TEST(LeastSquares, RefusesBadInputWithOneLine) {
   ObservationBlock one{MatrixXd::Identity(1, 2), VectorXd::Ones(1), MatrixXd::Identity(1, 1)};
   expect_input_error([&] { InformationFilter(none).estimate(); }, "singular (rank 0 of 2)");
   expect_input_error([&] { batch_least_squares({one}, none); }, "singular (rank 1 of 2)");
-  expect_input_error([&] { RecursiveLeastSquares rls(none); rls.add(one); rls.estimate(); }, "singular (rank 1 of 2)");
+  expect_input_error(
+      [&] {
+        RecursiveLeastSquares rls(none);
+        rls.add(one);
+        rls.estimate();
+      },
+      "singular (rank 1 of 2)");
   ObservationBlock wide = one;
   wide.H = MatrixXd::Identity(1, 3);
   expect_input_error([&] { InformationFilter(none).add(wide); }, "H: is 1x3, expected 1x2");
@@ -185,8 +191,11 @@ TEST(LeastSquares, RefusesBadInputWithOneLine) {
   expect_input_error([&] { batch_least_squares({bad_r}, none); }, "R: not symmetric");
   expect_input_error([&] { InformationPrior::from_moments(VectorXd::Zero(2), -MatrixXd::Identity(2, 2)); },
                      "prior P0: not positive definite (pivot 1)");
-  expect_input_error([&] { InformationFilter({MatrixXd::Identity(3, 3), VectorXd::Zero(2)}); },
-                     "prior Y: is 3x3, expected 2x2");
+  expect_input_error(
+      [&] {
+        InformationFilter({MatrixXd::Identity(3, 3), VectorXd::Zero(2)});
+      },
+      "prior Y: is 3x3, expected 2x2");
 }
 
 TEST(AttitudeOscillationModel, JacobianMatchesCentralDifference) {
@@ -215,8 +224,8 @@ TEST(AttitudeOscillationModel, SmallAnglesRotateTheFieldByAlphaCross) {
   d[6] = -2e-7;  // theta's sin wt
   d[12] = 3e-7;  // phi's cos wt
   const Vec<3> a = model.angles(t, d), r = model.reference(t), alpha{{a[2], a[0], a[1]}};
-  const Vec<3> cross{{alpha[1] * r[2] - alpha[2] * r[1], alpha[2] * r[0] - alpha[0] * r[2],
-                      alpha[0] * r[1] - alpha[1] * r[0]}};
+  const Vec<3> cross{
+      {alpha[1] * r[2] - alpha[2] * r[1], alpha[2] * r[0] - alpha[0] * r[2], alpha[0] * r[1] - alpha[1] * r[0]}};
   const Vec<3> reading = model.observation(t, d);
   for (int i = 0; i < 3; ++i) EXPECT_NEAR(reading[i], r[i] - cross[i], 1e-12) << i;
 }

@@ -25,7 +25,9 @@ MatrixXd taylor_exp(const MatrixXd& M) {
   return sum;
 }
 
-double relative(const MatrixXd& a, const MatrixXd& b) { return (a - b).cwiseAbs().maxCoeff() / b.cwiseAbs().maxCoeff(); }
+double relative(const MatrixXd& a, const MatrixXd& b) {
+  return (a - b).cwiseAbs().maxCoeff() / b.cwiseAbs().maxCoeff();
+}
 
 /// One RK4 step of dP/dt = f(P).
 MatrixXd rk4(const std::function<MatrixXd(const MatrixXd&)>& f, const MatrixXd& P, double h) {
@@ -84,7 +86,12 @@ TEST(SampledData, PredictionEqualsTheCovarianceOdeOverOneInterval) {
   MatrixXd P = P0;
   const int steps = 4000;
   for (int i = 0; i < steps; ++i)
-    P = rk4([&](const MatrixXd& p) { MatrixXd r = A * p + p * A.transpose() + GGt; return r; }, P, dt / steps);
+    P = rk4(
+        [&](const MatrixXd& p) {
+          MatrixXd r = A * p + p * A.transpose() + GGt;
+          return r;
+        },
+        P, dt / steps);
   EXPECT_LT(relative(predicted.P, P), 1e-11);
 }
 
@@ -135,10 +142,12 @@ double discrete_riccati_gap(double dt) {
   const int fine = 20000;
   const MatrixXd GGt = G * G.transpose(), Rinv = R.inverse();
   for (int i = 0; i < fine; ++i)
-    P = rk4([&](const MatrixXd& p) {
+    P = rk4(
+        [&](const MatrixXd& p) {
           MatrixXd r = A * p + p * A.transpose() + GGt - p * H.transpose() * Rinv * H * p;
           return r;
-        }, P, T / fine);
+        },
+        P, T / fine);
   const DiscreteTransition transition = discretize(A, G, dt);
   const MatrixXd Rk = averaged_observation_noise(R, dt);
   GaussianEstimate e{VectorXd::Zero(2), P0};
@@ -161,8 +170,11 @@ TEST(SampledData, RefusesBadInputWithOneLine) {
   MatrixXd R(2, 2);
   R << 1.0, 2.0, 2.0, 1.0;
   expect_input_error([&] { averaged_observation_noise(R, 0.1); }, "R: not positive definite (pivot 2)");
-  expect_input_error([&] { update_gain_form({VectorXd::Zero(2), A}, MatrixXd::Zero(2, 3), VectorXd::Zero(2), A); },
-                     "update: H: is 2x3, expected 2x2");
+  expect_input_error(
+      [&] {
+        update_gain_form({VectorXd::Zero(2), A}, MatrixXd::Zero(2, 3), VectorXd::Zero(2), A);
+      },
+      "update: H: is 2x3, expected 2x2");
 }
 
 }  // namespace

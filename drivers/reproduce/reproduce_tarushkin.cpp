@@ -92,7 +92,7 @@ double log_slope(const std::vector<double>& x, const std::vector<double>& y) {
 
 const char* const angle_names[3] = {"psi", "theta", "phi"};
 const char* const harmonic_names[AttitudeOscillationModel::num_harmonics] = {"1", "sin wt", "cos wt", "sin 2wt",
-                                                                              "cos 2wt"};
+                                                                             "cos 2wt"};
 
 }  // namespace
 
@@ -192,7 +192,8 @@ ExampleResult reproduce_tarushkin_attitude(const ReproduceSettings& settings, co
     convergence += std::to_string(points[p]) + "," + std::to_string(n) + "," + format_number(n * settings.dt) + "," +
                    format_number(rms) + "," + format_number(rms_se) + "," + format_number(s.predicted_rms) + "," +
                    format_number(s.nees.mean()) + "," + format_number(s.nees.standard_error()) + "," +
-                   format_number(s.condition) + "," + (s.gain_form ? "1," : "0,") + format_number(s.rls_difference) + "," + format_number(s.info_difference) + "\n";
+                   format_number(s.condition) + "," + (s.gain_form ? "1," : "0,") + format_number(s.rls_difference) +
+                   "," + format_number(s.info_difference) + "\n";
     if (n * settings.dt >= orbit || p + 1 == points.size()) {
       sample_counts.push_back(static_cast<double>(n));
       rms_errors.push_back(rms);
@@ -204,8 +205,9 @@ ExampleResult reproduce_tarushkin_attitude(const ReproduceSettings& settings, co
     info_worst = std::max(info_worst, s.info_difference);
   }
   std::string coefficients =
-      comment + "coefficient,angle,harmonic,predicted_sd,rms_error,rms_error_se,member0_truth,member0_batch,"
-                "member0_rls,member0_info\n";
+      comment +
+      "coefficient,angle,harmonic,predicted_sd,rms_error,rms_error_se,member0_truth,member0_batch,"
+      "member0_rls,member0_info\n";
   for (int c = 0; c < 15; ++c) {
     const double rms = std::sqrt(coefficient_error[c].mean());
     coefficients += "d" + std::to_string(c + 1) + "," + angle_names[c / 5] + "," + harmonic_names[c % 5] + "," +
