@@ -91,6 +91,7 @@ const Example examples[] = {
     {"sunahara-ex1", reproduce_sunahara_ex1, true, 10.0, 2e-3, 100, 1024},
     {"sunahara-ex2", reproduce_sunahara_ex2, true, 5.0, 2e-3, 100, 1024},
     {"clark-table-2.1", reproduce_clark_table_2_1, true, 100.0, 1.0, 500, 1024},
+    {"tarushkin-attitude", reproduce_tarushkin_attitude, true, 10800.0, 10.0, 200, 0},
 };
 
 const Example& find_example(const std::string& name) {
@@ -213,8 +214,13 @@ int run_reproduce(const ReproduceOptions& options, const RunContext& context_in)
     summary["reproduce"] = {{"example", example.name}, {"rows", rows_json(result.table)}};
     summary["files"].push_back("reproduction.csv");
     summary["files"].push_back("reproduction.md");
+    if (settings.plots && !result.compare_report) {  // nothing for the compare figures to draw
+      out.write("report.md", table_md);
+      summary["files"].push_back("report.md");
+      summary["plots"] = false;
+    }
     out.write("summary.json", summary.dump(2) + "\n");
-    if (settings.plots) add_plots(out, summary);  // report.md includes reproduction.md
+    if (settings.plots && result.compare_report) add_plots(out, summary);  // report.md includes reproduction.md
   } else {
     nlohmann::json top = run_metadata(context);
     top["reproduce"] = {{"example", example.name}, {"rows", rows_json(result.table)}};

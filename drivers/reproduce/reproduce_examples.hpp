@@ -51,6 +51,8 @@ struct ExampleResult {
   std::string notes;              // markdown: what ran, with which sizes and readings
   nlohmann::json summary;         // one run: its compare summary; several: {"runs": {name: summary}}
   std::vector<std::string> runs;  // subdirectories holding the runs' artefacts; empty: the output directory itself
+  // false: the example wrote no compare run (no timeseries.csv for the figures), so report.md is the table alone
+  bool compare_report = true;
 };
 
 /// The terminal values of `trajectories.csv` (as `kushner compare` writes it) for `member`: (series, component)
@@ -78,5 +80,7 @@ ExampleResult reproduce_basin_terpolymer(const ReproduceSettings& settings, cons
                                          const OutputDirectory& out);
 ExampleResult reproduce_clark_table_2_1(const ReproduceSettings& settings, const RunContext& context,
                                         const OutputDirectory& out);
+ExampleResult reproduce_tarushkin_attitude(const ReproduceSettings& settings, const RunContext& context,
+                                           const OutputDirectory& out);
 
 }  // namespace kushner

@@ -131,6 +131,35 @@ assert claim == "reproduces" and kbl > 2 * bilin, (claim, bilin, mixed, kbl)
 PY
 echo "ok: sunahara-ex1 (its own numbers, and a perturbed reference fails), sunahara-ex2, basin-terpolymer"
 
+# tarushkin-attitude (seed 004 §4): batch LS = recursive LS = information filter to rounding, and the estimates
+# converge to the simulated coefficients as P predicts (50 members: NEES and RMS error within 4 standard errors).
+run_kushner "$work/tarushkin" reproduce tarushkin-attitude --out "$work/tarushkin" --members 50 --quiet --no-plots
+[ "$rc" -eq 0 ] || fail "reproduce tarushkin-attitude failed: $(cat "$work/tarushkin.err")"
+for f in summary.json reproduction.csv reproduction.md convergence.csv coefficients.csv; do
+  [ -s "$work/tarushkin/$f" ] || fail "reproduce tarushkin-attitude did not write $f"
+done
+"$python" - "$work/tarushkin" <<'PY' || fail "tarushkin-attitude: agreement or convergence numbers wrong"
+import csv, json, math, sys
+d = sys.argv[1]
+s = json.load(open(d + "/summary.json"))["tarushkin"]
+rows = {r["key"]: r for r in csv.DictReader(l for l in open(d + "/reproduction.csv") if not l.startswith("#"))}
+assert rows["claim/filter_is_least_squares"]["verdict"] == "reproduces", rows["claim/filter_is_least_squares"]
+assert s["compared_checkpoints"] >= 5, s
+for key in ("agreement/rls", "agreement/info"):
+    assert 0 <= float(rows[key]["ours"]) < 1e-10, (key, rows[key]["ours"])
+assert abs(s["nees_T"] - 1) < 4 * s["nees_T_se"], (s["nees_T"], s["nees_T_se"])
+assert abs(s["rms_error_T"] - s["predicted_rms_T"]) < 4 * s["rms_error_T_se"], s
+assert -0.65 < s["slope"] < -0.35, s["slope"]
+assert rows["observability/omega_orbit"]["ours"] == "12 of 15", rows["observability/omega_orbit"]
+conv = list(csv.DictReader(l for l in open(d + "/convergence.csv") if not l.startswith("#")))
+assert float(conv[-1]["rms_error"]) < 1e-3 * float(conv[0]["rms_error"]), (conv[0], conv[-1])
+coef = list(csv.DictReader(l for l in open(d + "/coefficients.csv") if not l.startswith("#")))
+assert len(coef) == 15 and all(abs(float(c["member0_batch"]) - float(c["member0_info"])) < 1e-12 for c in coef)
+print(f"ok: tarushkin-attitude: agreement {float(rows['agreement/rls']['ours']):.2g}, "
+      f"{float(rows['agreement/info']['ours']):.2g}; NEES {s['nees_T']:.3f} +- {s['nees_T_se']:.3f}; "
+      f"RMS {s['rms_error_T']:.3g} vs predicted {s['predicted_rms_T']:.3g}; slope {s['slope']:.3f}")
+PY
+
 # Basin's regulators and controller (seed 002): files, every row of the data files on stdout with a verdict, and
 # numbers that can fail: the printed linear q(0) to its printed digits, the direct optimum at most every law's J,
 # the impossible printed J explained, the controller's loops equal to `kushner control`'s.
@@ -224,7 +253,7 @@ expect_refused() {  # expect_refused "message fragment" args...: one line, exit 
   [ ! -e "$work/refused" ] || fail "a refused run created its output directory: $*"
   echo "ok: $(cat "$work/r.err")"
 }
-expect_refused "reproduce: unknown example 'basin-car' (known: basin-car-filter, basin-terpolymer, basin-car-regulator, basin-regulator-enotes, basin-car-controller, sunahara-ex1, sunahara-ex2)" \
+expect_refused "reproduce: unknown example 'basin-car' (known: basin-car-filter, basin-terpolymer, basin-car-regulator, basin-regulator-enotes, basin-car-controller, sunahara-ex1, sunahara-ex2, clark-table-2.1, tarushkin-attitude)" \
   reproduce basin-car --out "$work/refused"
 expect_refused "--out is required" reproduce basin-car-filter
 expect_refused "--members: basin-car-filter is deterministic" reproduce basin-car-filter --members 10 --out "$work/refused"
