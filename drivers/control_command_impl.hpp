@@ -215,8 +215,9 @@ nlohmann::json run_controlled_model(const Model& model, const ControlOptions& op
   // Everything is checked before the output directory is opened.
   const std::vector<ControllerSpec> specs = select_controllers(options.controllers, model);
   const QuadraticCost<n, m> cost = parse_cost<Model>(options.cost);
-  KUSHNER_INPUT_REQUIRE(!Model::discrete_time || options.reference == "auto" || options.reference == "none",
-                        "--reference " << options.reference << ": no reference solver for discrete-time models (use none)");
+  KUSHNER_INPUT_REQUIRE(
+      !Model::discrete_time || options.reference == "auto" || options.reference == "none",
+      "--reference " << options.reference << ": no reference solver for discrete-time models (use none)");
   KUSHNER_INPUT_REQUIRE(!cost.weighs_estimation() || options.reference == "auto" || options.reference == "none",
                         "--reference " << options.reference << ": the reference solvers' cost has no estimation-error "
                                        << "term (D = 0 only; use --reference none)");

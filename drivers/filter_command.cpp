@@ -65,8 +65,6 @@ int run_filter(const FilterOptions& options, const RunContext& context) {
   return run_estimation(compare, context);
 }
 
-int run_compare(const CompareOptions& options, const RunContext& context) {
-  return run_estimation(options, context);
-}
+int run_compare(const CompareOptions& options, const RunContext& context) { return run_estimation(options, context); }
 
 }  // namespace kushner

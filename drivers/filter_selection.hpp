@@ -22,7 +22,7 @@ EstimatorTable estimator_table(const Model& model) {
   const std::vector<FilterSupport> own = filter_support(model);  // the filters of the model's time
   for (const std::string& name : all_filter_names()) {           // every filter, in report order
     const auto f = std::find_if(own.begin(), own.end(), [&](const FilterSupport& s) { return s.name == name; });
-    table.bank.push_back({name, f != own.end()        ? f->unsupported
+    table.bank.push_back({name, f != own.end()         ? f->unsupported
                                 : Model::discrete_time ? "a continuous-time filter; the model is discrete-time"
                                                        : "a discrete-time filter; the model is continuous-time"});
   }

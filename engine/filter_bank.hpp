@@ -164,9 +164,9 @@ class FilterBank {
   /// Step k, over [k dt, (k + 1) dt]; `record`: (k + 1) dt is an output time.
   void step(long k, double dt, bool record) {
     const auto step = static_cast<std::uint32_t>(k);
-    typename K::Step kernel{TruthStep<TruthModel, MemSpace>{
-                                truth_model_, truths_.state(), truths_.observations(), k * dt, dt, seed_, step},
-                            filter_model_, truth_status_, slots_, record};
+    typename K::Step kernel{
+        TruthStep<TruthModel, MemSpace>{truth_model_, truths_.state(), truths_.observations(), k * dt, dt, seed_, step},
+        filter_model_, truth_status_, slots_, record};
     parallel_for_members("kushner::filter_bank_step", space_, members_, kernel);
     bool reference_stepped = false;
     for (auto& e : estimators_) {

@@ -178,8 +178,9 @@ struct declares_linear_transition<Model, std::enable_if_t<Model::linear_transiti
 template <class Model, class = void>
 struct has_bounded_noises : std::false_type {};
 template <class Model>
-struct has_bounded_noises<Model, std::void_t<decltype(std::declval<const Model&>().w.bound),
-                                             decltype(std::declval<const Model&>().v.bound)>> : std::true_type {};
+struct has_bounded_noises<
+    Model, std::void_t<decltype(std::declval<const Model&>().w.bound), decltype(std::declval<const Model&>().v.bound)>>
+    : std::true_type {};
 }  // namespace detail
 
 /// Capabilities of a discrete-time model (x[k+1] = F(k, x, u) + w, z = h(k, x) + v), as its filters see them.

@@ -54,7 +54,7 @@ void expect_every_filter_equals_kalman_bucy(const Model& model, Expectations qlf
   std::vector<std::string> filters, deterministic;
   for (const auto& name : supported_filters(model))
     if (std::find(randomized.begin(), randomized.end(), name) == randomized.end()) filters.push_back(name);
-  for (const auto& name : all_filter_names())
+  for (const auto& name : filter_names<Model>())
     if (std::find(randomized.begin(), randomized.end(), name) == randomized.end()) deterministic.push_back(name);
   ASSERT_EQ(filters, deterministic) << "every filter supports a linear model";
   ASSERT_EQ(randomized, (std::vector<std::string>{"EnKBF", "EnKBF-S"}));  // tests/filters/test_ensemble_kalman_bucy

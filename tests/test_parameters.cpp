@@ -58,8 +58,8 @@ std::string error_of(const std::string& name, const std::vector<std::string>& se
 TEST(Registry, RefusesBadInputWithOneClearMessage) {
   EXPECT_EQ(
       error_of("sin", {}),
-      "--model: unknown model 'sin' (known: benes, car, car-taylor3, clark-linear, cubic-oscillator, cubic-sensor, "
-      "linear, ou, pendulum, range-bearing, sine, terpolymer)");
+      "--model: unknown model 'sin' (known: benes, car, car-taylor3, clark-linear, clark-quintic, cubic-oscillator, "
+      "cubic-sensor, linear, linear-discrete, ou, pendulum, range-bearing, sine, terpolymer)");
   EXPECT_NE(error_of("sine", {"z=1"}).find("model 'sine' has no parameter 'z' (known: q, r,"), std::string::npos);
   EXPECT_NE(error_of("sine", {"q"}).find("expected key=value"), std::string::npos);
   EXPECT_NE(error_of("linear", {"dim=4"}).find("supports dim 1, 2, 3"), std::string::npos);

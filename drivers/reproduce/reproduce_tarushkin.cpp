@@ -227,7 +227,9 @@ ExampleResult reproduce_tarushkin_attitude(const ReproduceSettings& settings, co
   result.compare_report = false;
   nlohmann::json& summary = result.summary;
   summary = run_metadata(context);
-  summary["model"] = {{"name", model.name}, {"parameters", parameter_values(model)}};
+  // Two statements, not one braced list: nvcc's front end (CUDA 13) mangles {{"name", model.name}, ...} here.
+  summary["model"]["name"] = AttitudeOscillationModel::name;
+  summary["model"]["parameters"] = parameter_values(model);
   summary["tarushkin"] = {{"members", settings.members},
                           {"samples", samples},
                           {"dt", settings.dt},

@@ -89,8 +89,8 @@ class ControlLoop {
   /// Step k over [k dt, (k + 1) dt]; `record`: (k + 1) dt is an output time.
   void step(long k, double dt, bool record) {
     typename K::Step kernel;
-    kernel.truth = TruthStep<Model, MemSpace>{
-        model_, truths_.state(), truths_.observations(), k * dt, dt, seed_, static_cast<std::uint32_t>(k)};
+    kernel.truth = TruthStep<Model, MemSpace>{model_, truths_.state(), truths_.observations(),       k * dt,
+                                              dt,     seed_,           static_cast<std::uint32_t>(k)};
     kernel.model = model_;
     kernel.truth_status = truth_status_;
     kernel.slots = slots_;

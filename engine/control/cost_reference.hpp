@@ -32,14 +32,14 @@ bool deterministic_problem(const Model& model) {
   if constexpr (Model::discrete_time) {
     return false;  // the discrete-time models have noise of their own law (no direct solver for them)
   } else {
-  const auto G = model.diffusion(0.0, model.x0_mean);
-  for (int i = 0; i < Model::state_dim; ++i) {
-    for (int j = 0; j < Model::noise_dim; ++j)
-      if (G(i, j) != 0.0) return false;
-    for (int j = 0; j < Model::state_dim; ++j)
-      if (model.x0_cov(i, j) != 0.0) return false;
-  }
-  return true;
+    const auto G = model.diffusion(0.0, model.x0_mean);
+    for (int i = 0; i < Model::state_dim; ++i) {
+      for (int j = 0; j < Model::noise_dim; ++j)
+        if (G(i, j) != 0.0) return false;
+      for (int j = 0; j < Model::state_dim; ++j)
+        if (model.x0_cov(i, j) != 0.0) return false;
+    }
+    return true;
   }
 }
 
@@ -62,19 +62,19 @@ std::optional<CostReference> cost_reference(const Model& model,
   if (kind == "auto") chosen = deterministic ? "direct" : hjb_solvable<Model>() ? "hjb" : "none";
   if (chosen == "none") return std::nullopt;
   if constexpr (!Model::discrete_time) {
-  if (chosen == "direct") {
-    KUSHNER_INPUT_REQUIRE(deterministic,
-                          "--reference direct: the problem is stochastic (process noise or a random "
-                          "start); the direct method needs a deterministic one");
-    const auto optimum = direct_optimum(model, cost, model.x0_mean, grid.steps, grid.dt);
-    return CostReference{"direct",
-                         optimum.J,
-                         0.0,
-                         {{"iterations", static_cast<long>(optimum.iterations)},
-                          {"gradient_norm", optimum.gradient_norm},
-                          {"converged", static_cast<long>(optimum.converged)},
-                          {"reason", optimum.reason}}};
-  }
+    if (chosen == "direct") {
+      KUSHNER_INPUT_REQUIRE(deterministic,
+                            "--reference direct: the problem is stochastic (process noise or a random "
+                            "start); the direct method needs a deterministic one");
+      const auto optimum = direct_optimum(model, cost, model.x0_mean, grid.steps, grid.dt);
+      return CostReference{"direct",
+                           optimum.J,
+                           0.0,
+                           {{"iterations", static_cast<long>(optimum.iterations)},
+                            {"gradient_norm", optimum.gradient_norm},
+                            {"converged", static_cast<long>(optimum.converged)},
+                            {"reason", optimum.reason}}};
+    }
   }
   KUSHNER_INPUT_REQUIRE(chosen == "hjb", "--reference: unknown kind '" << kind << "' (auto, hjb, direct, none)");
   if constexpr (hjb_solvable<Model>()) {

@@ -57,8 +57,8 @@ RiccatiSolution<N, M> solve_discrete_lqr(long steps, const QuadraticCost<N, M>& 
     const Eigen::Matrix<double, M, N> K = solver.solve(B.transpose() * S * A);
     const VecN Sa_s = S * a + s;
     const Eigen::Matrix<double, M, 1> kk = solver.solve(B.transpose() * Sa_s);
-    const double c_next = target.dot(Q * target) + a.dot(S * a) + 2.0 * s.dot(a) - kk.dot(G * kk) + c +
-                          (S * to_eigen(noise(k))).trace();
+    const double c_next =
+        target.dot(Q * target) + a.dot(S * a) + 2.0 * s.dot(a) - kk.dot(G * kk) + c + (S * to_eigen(noise(k))).trace();
     const MatN S_next = Q + A.transpose() * S * A - K.transpose() * G * K;
     s = -Q * target + A.transpose() * Sa_s - K.transpose() * G * kk;
     S = 0.5 * (S_next + S_next.transpose());

@@ -25,8 +25,9 @@ struct ClarkApproximateFilter {
                                       : Estimate == ClarkEstimate::straight_line ? "MOM-LINE"
                                                                                  : "MOM-HYP";
   static constexpr const char* description =
-      Estimate == ClarkEstimate::midpoint        ? "Clark's midpoint of the posterior bounds (Clark 1971 (2.20), (4.7))"
-      : Estimate == ClarkEstimate::least_squares ? "Clark's least-squares cubic z - 0.119 z^3 (Clark 1971 (2.28), Ex. 1)"
+      Estimate == ClarkEstimate::midpoint ? "Clark's midpoint of the posterior bounds (Clark 1971 (2.20), (4.7))"
+      : Estimate == ClarkEstimate::least_squares
+          ? "Clark's least-squares cubic z - 0.119 z^3 (Clark 1971 (2.28), Ex. 1)"
       : Estimate == ClarkEstimate::straight_line ? "Clark's straight line 0.525 z (Clark 1971 (2.29), Ex. 1)"
                                                  : "Clark's (sinh z + tanh z)/2 (Clark 1971 (2.30), Ex. 1)";
   static constexpr const char* unsupported = clark_filter_unsupported<Model>();

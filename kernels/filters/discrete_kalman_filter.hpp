@@ -3,8 +3,9 @@
 // step k -> k + 1 predicts with the transition, then updates with z[k+1] (StepInput::dy):
 //   m- = F(k, m, 0),  P- = A P A^T + Q,                      A = dF/dx at m, Q = Cov w
 //   S = H P- H^T + V,  K = P- H^T S^-1,  m = m- + K (z - h(k+1, m-)),  P = (I - K H) P- (I - K H)^T + K V K^T
-// (Joseph form: P stays symmetric positive semidefinite); a closed loop's known input B u[k] is added to m-. On a linear Gaussian model this is the exact filter;
-// on Clark's bounded noises it is the best linear one (it uses only the noises' covariances).
+// (Joseph form: P stays symmetric positive semidefinite); a closed loop's known input B u[k] is added to m-. On a
+// linear Gaussian model this is the exact filter; on Clark's bounded noises it is the best linear one (it uses only the
+// noises' covariances).
 //   KF      covariance form, linear models
 //   KF-INF  information form of the same update, Y = P^-1:  Y = Y- + H^T V^-1 H,  y = Y- m- + H^T V^-1 (z - h(0)),
 //           the recursive least-squares recursion (004 (4.9)-(4.17)); equal to KF to rounding
@@ -63,7 +64,8 @@ template <class Model, class MemSpace>
 struct KalmanFilter {
   static constexpr int n = Model::state_dim, p = Model::obs_dim;
   static constexpr const char* name = "KF";
-  static constexpr const char* description = "discrete Kalman filter, covariance form (Tarushkin 1972; Clark 1971 ch. II)";
+  static constexpr const char* description =
+      "discrete Kalman filter, covariance form (Tarushkin 1972; Clark 1971 ch. II)";
   static constexpr const char* unsupported = detail::discrete_kalman_unsupported<Model>();
 
   static KalmanFilter create(const OptionValues&, const Model&, long) { return {}; }

@@ -1,8 +1,8 @@
 #pragma once
 // The bank's kernels. One step is one pass over the members: each member's truth takes its Euler-Maruyama
 // step (producing dy; a discrete-time model: its transition, producing z[k+1]), then every selected filter
-// takes its step with that same observation and is scored against the new truth. The filters are a compile-time list (no virtual calls); unselected ones are skipped by a
-// flag that is the same for every member.
+// takes its step with that same observation and is scored against the new truth. The filters are a compile-time list
+// (no virtual calls); unselected ones are skipped by a flag that is the same for every member.
 #include "kernels/filters/filter_slot.hpp"
 #include "kernels/simulate_truth.hpp"
 

@@ -47,10 +47,10 @@ using ContinuousTimeFilters =
 
 template <class Model, class MemSpace>
 using DiscreteTimeFilters =
-    std::tuple<KalmanFilter<Model, MemSpace>, InformationFilter<Model, MemSpace>, ExtendedKalmanFilterD<Model, MemSpace>,
-               MomentFilter<Model, MemSpace>, ClarkMidpointFilter<Model, MemSpace>,
-               ClarkLeastSquaresFilter<Model, MemSpace>, ClarkStraightLineFilter<Model, MemSpace>,
-               ClarkHyperbolicFilter<Model, MemSpace>>;
+    std::tuple<KalmanFilter<Model, MemSpace>, InformationFilter<Model, MemSpace>,
+               ExtendedKalmanFilterD<Model, MemSpace>, MomentFilter<Model, MemSpace>,
+               ClarkMidpointFilter<Model, MemSpace>, ClarkLeastSquaresFilter<Model, MemSpace>,
+               ClarkStraightLineFilter<Model, MemSpace>, ClarkHyperbolicFilter<Model, MemSpace>>;
 
 /// The filters of Model's time (continuous or discrete): a model's filters are never compiled for the other time.
 template <class Model, class MemSpace>
@@ -122,6 +122,15 @@ void for_each_named_filter(F&& f) {
 inline std::vector<std::string> all_filter_names() {
   std::vector<std::string> names;
   for_each_named_filter([&](auto* tag) { names.push_back(std::remove_pointer_t<decltype(tag)>::name); });
+  return names;
+}
+
+/// The names of the filters of Model's time (continuous or discrete), in report order, supported or not.
+template <class Model>
+std::vector<std::string> filter_names() {
+  std::vector<std::string> names;
+  for_each_filter_type<Model, Kokkos::HostSpace>(
+      [&](auto* tag) { names.push_back(std::remove_pointer_t<decltype(tag)>::name); });
   return names;
 }
 

@@ -9,9 +9,10 @@
 //   3. Bayes' rule with z (2.9)-(2.10): the polynomial times v's density on the posterior support, its
 //      moments by Gauss-Legendre quadrature (exact for uniform v: degree <= 2M; the interval is split at z
 //      so that |z - x|^rho_v is smooth on each piece). m = mu_1, P = mu_2 - mu_1^2 ((2.14), (2.17)).
-// M = 4 is Clark's "fourth-order nonlinear filter". The polynomial can dip below zero where the true predicted
-// density is near zero (Clark's rho = 10 plant noise): a member whose normalizer or variance is not positive
-// diverges (counted, frozen).
+// M = 4 is Clark's "fourth-order nonlinear filter". The moment-matched polynomial dips below zero where the true
+// predicted density is near zero (Clark's rho = 10 plant noise is zero at 0): those dips are cut to zero in Bayes'
+// rule (unclipped, most members of clark-linear met a negative normalizer or variance within a few steps; the
+// thesis does not say how it met them). A member whose normalizer or variance is still not positive diverges.
 #include "kernels/filters/clark_bounds.hpp"
 #include "kernels/filters/filter_protocol.hpp"
 #include "kernels/filters/filter_step.hpp"
@@ -34,7 +35,7 @@ struct MomentFilter {
   static constexpr const char* unsupported = clark_filter_unsupported<Model>();
 
   int order = 4;
-  double node[nodes], weight[nodes];  // on [-1, 1]
+  double node[nodes], weight[nodes];                           // on [-1, 1]
   Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> state;  // (member, 0: l, 1: f, 1 + j: mu_j)
 
   static std::vector<OptionSpec> options() {
@@ -53,9 +54,10 @@ struct MomentFilter {
       host(member, 0) = prior.lower;
       host(member, 1) = prior.upper;
       for (int j = 1; j <= f.order; ++j)  // the uniform law on [l, f], or the point l = f
-        host(member, 1 + j) = prior.upper > prior.lower ? (std::pow(prior.upper, j + 1) - std::pow(prior.lower, j + 1)) /
-                                                               ((j + 1) * (prior.upper - prior.lower))
-                                                         : std::pow(prior.lower, j);
+        host(member, 1 + j) = prior.upper > prior.lower
+                                  ? (std::pow(prior.upper, j + 1) - std::pow(prior.lower, j + 1)) /
+                                        ((j + 1) * (prior.upper - prior.lower))
+                                  : std::pow(prior.lower, j);
     }
     Kokkos::deep_copy(f.state, host);
     return f;
@@ -89,8 +91,7 @@ struct MomentFilter {
       }
       predicted[i] = sum;
     }
-    const Interval support =
-        clark_predicted_bounds({state(member, 0), state(member, 1)}, a, c, model.w.bound);
+    const Interval support = clark_predicted_bounds({state(member, 0), state(member, 1)}, a, c, model.w.bound);
     // 2. Legendre coefficients of the predicted density of s = (x - centre) / half on [-1, 1].
     const double centre = 0.5 * (support.lower + support.upper), half = 0.5 * (support.upper - support.lower);
     double s_moment[max_order + 1];
@@ -105,7 +106,7 @@ struct MomentFilter {
     double coefficient[max_order + 1];  // b_i = (2i + 1)/2 E[P_i(s)], P_i in monomials by the recurrence
     double previous[max_order + 1], current[max_order + 1], next[max_order + 1];
     for (int j = 0; j <= M; ++j) previous[j] = current[j] = 0.0;
-    previous[0] = 1.0;  // P_0
+    previous[0] = 1.0;             // P_0
     if (M >= 1) current[1] = 1.0;  // P_1
     coefficient[0] = 0.5;
     for (int i = 1; i <= M; ++i) {
@@ -113,8 +114,7 @@ struct MomentFilter {
       for (int j = 0; j <= i; ++j) expectation += current[j] * s_moment[j];
       coefficient[i] = 0.5 * (2 * i + 1) * expectation;
       // P_{i+1} = ((2i + 1) s P_i - i P_{i-1}) / (i + 1)
-      for (int j = 0; j <= M; ++j)
-        next[j] = ((j > 0 ? (2 * i + 1) * current[j - 1] : 0.0) - i * previous[j]) / (i + 1);
+      for (int j = 0; j <= M; ++j) next[j] = ((j > 0 ? (2 * i + 1) * current[j - 1] : 0.0) - i * previous[j]) / (i + 1);
       for (int j = 0; j <= M; ++j) {
         previous[j] = current[j];
         current[j] = next[j];
@@ -139,6 +139,7 @@ struct MomentFilter {
           p_prev = p_cur;
           p_cur = p_next;
         }
+        density = density > 0.0 ? density : 0.0;  // the polynomial's dips below zero are no probability
         double mass = radius * weight[q] * density * model.v.density(z - x), power = 1.0;
         for (int j = 0; j <= M; ++j) {
           moment[j] += mass * power;

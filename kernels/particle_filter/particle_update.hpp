@@ -130,7 +130,8 @@ KOKKOS_INLINE_FUNCTION double update_particle(const ParticleStepData<Model, MemS
     return 0.0;
   } else if constexpr (Model::discrete_time) {
     x = d.model.transition(t, x, control) + d.model.process_noise(z, u);
-    const double l = log_weight - log_normalizer + d.model.observation_log_density(vinv_dy - d.model.observation(t + 1.0, x));
+    const double l =
+        log_weight - log_normalizer + d.model.observation_log_density(vinv_dy - d.model.observation(t + 1.0, x));
     bool finite = math::is_finite(l);
     KUSHNER_UNROLL_FULLY
     for (int i = 0; i < n; ++i) finite = finite & math::is_finite(x[i]);

@@ -19,7 +19,7 @@ expect_refused() {  # expect_refused "expected message fragment" args...
 }
 
 fresh="$work/fresh"
-expect_refused "unknown model 'sin' (known: benes, car, car-taylor3, clark-linear, cubic-oscillator, cubic-sensor, linear, ou, pendulum, range-bearing, sine, terpolymer)" simulate --model sin --out "$fresh"
+expect_refused "unknown model 'sin' (known: benes, car, car-taylor3, clark-linear, clark-quintic, cubic-oscillator, cubic-sensor, linear, linear-discrete, ou, pendulum, range-bearing, sine, terpolymer)" simulate --model sin --out "$fresh"
 expect_refused "--dt: must be positive (got 0)" simulate --dt 0 --out "$fresh"
 expect_refused "--dt: must be positive (got -1)" simulate --dt -1 --out "$fresh"
 expect_refused "--members: must be positive (got 0)" simulate --members 0 --out "$fresh"

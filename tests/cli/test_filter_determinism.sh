@@ -76,3 +76,6 @@ compare_runs sine --model sine --filters all --members 2000 --T 1 --dt 1e-2 --se
 compare_runs cubic --model cubic-oscillator --filters all --members 1001 --T 0.5 --dt 5e-3 --seed 8 --output-points 10
 compare_runs car --model car --filters all --members 500 --T 0.5 --dt 5e-3 --seed 9 --output-points 10
 compare_runs terpolymer --model terpolymer --filters BILIN,MIXED,KBL,EKF --members 300 --T 0.2 --dt 1e-2 --seed 10
+# Discrete time (steps of 1, no --dt): every discrete filter, the particle filter and the grid Bayes filter.
+compare_runs clark --model clark-linear --filters all,EXACT --members 700 --particles 256 --T 15 --seed 11
+compare_runs gauss-discrete --model linear-discrete --filters all --members 600 --particles 256 --T 15 --seed 12

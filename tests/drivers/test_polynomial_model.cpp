@@ -383,11 +383,11 @@ TEST(PolynomialModel, FiltersTheCoefficientsRuleOutAreRefusedAtSelection) {
   const auto vdp = model_from_file<2>("van_der_pol.toml");
   const auto linear = model_from_file<2>("linear2.toml");
   using Cubic = PolynomialModel<2>;
-  EXPECT_EQ(select_filters<Cubic>("all", linear), all_filter_names()) << "a linear file supports every filter";
+  EXPECT_EQ(select_filters<Cubic>("all", linear), filter_names<Cubic>()) << "a linear file supports every filter";
   // "all" is every filter but those the coefficients rule out (the list is the filter list's, in its order).
   const auto all_but = [](std::vector<std::string> refused) {
     std::vector<std::string> names;
-    for (const auto& n : all_filter_names())
+    for (const auto& n : filter_names<Cubic>())
       if (std::find(refused.begin(), refused.end(), n) == refused.end()) names.push_back(n);
     return names;
   };
