@@ -60,21 +60,25 @@ KOKKOS_INLINE_FUNCTION bool discrete_covariance_update(const Model& model, const
 
 }  // namespace detail
 
-template <class Model, class MemSpace>
-struct KalmanFilter {
+/// The covariance-form step KF and EKF-D share (they differ in the models they accept).
+template <class Model>
+struct DiscreteKalmanStep {
   static constexpr int n = Model::state_dim, p = Model::obs_dim;
+  KOKKOS_INLINE_FUNCTION Status step(const Model& model, int, const StepInput<p>& in, Vec<n>& m, Mat<n, n>& P,
+                                     const Vec<n>& known_input) const {
+    detail::discrete_predict(model, in.t, known_input, m, P);
+    return detail::discrete_covariance_update(model, in, m, P) ? Status::ok : Status::not_positive_definite;
+  }
+};
+
+template <class Model, class MemSpace>
+struct KalmanFilter : DiscreteKalmanStep<Model> {
   static constexpr const char* name = "KF";
   static constexpr const char* description =
       "discrete Kalman filter, covariance form (Tarushkin 1972; Clark 1971 ch. II)";
   static constexpr const char* unsupported = detail::discrete_kalman_unsupported<Model>();
 
   static KalmanFilter create(const OptionValues&, const Model&, long) { return {}; }
-
-  KOKKOS_INLINE_FUNCTION Status step(const Model& model, int, const StepInput<p>& in, Vec<n>& m, Mat<n, n>& P,
-                                     const Vec<n>& known_input) const {
-    detail::discrete_predict(model, in.t, known_input, m, P);
-    return detail::discrete_covariance_update(model, in, m, P) ? Status::ok : Status::not_positive_definite;
-  }
 };
 
 template <class Model, class MemSpace>
@@ -111,20 +115,13 @@ struct InformationFilter {
 };
 
 template <class Model, class MemSpace>
-struct ExtendedKalmanFilterD {
-  static constexpr int n = Model::state_dim, p = Model::obs_dim;
+struct ExtendedKalmanFilterD : DiscreteKalmanStep<Model> {
   static constexpr const char* name = "EKF-D";
   static constexpr const char* description = "discrete extended Kalman filter (linearized at the estimate)";
   static constexpr const char* unsupported =
       Model::discrete_time ? nullptr : "continuous-time model (discrete-time filter)";
 
   static ExtendedKalmanFilterD create(const OptionValues&, const Model&, long) { return {}; }
-
-  KOKKOS_INLINE_FUNCTION Status step(const Model& model, int, const StepInput<p>& in, Vec<n>& m, Mat<n, n>& P,
-                                     const Vec<n>& known_input) const {
-    detail::discrete_predict(model, in.t, known_input, m, P);
-    return detail::discrete_covariance_update(model, in, m, P) ? Status::ok : Status::not_positive_definite;
-  }
 };
 
 }  // namespace kushner

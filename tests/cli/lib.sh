@@ -19,3 +19,14 @@ can_draw_figures() {
   fi
   "$plot_python" -c "import matplotlib" 2>/dev/null
 }
+# expect_refused "exact message" args...: kushner exits 2 with exactly "kushner: error: <message>" on stderr and
+# creates no output directory (--out $work/refused is added). Scripts that match a fragment define their own.
+expect_refused() {
+  local expected=$1; shift
+  run_kushner "$work/r" "$@" --out "$work/refused"
+  [ "$rc" -eq 2 ] || fail "exit $rc (want 2) for: $*; stderr: $(cat "$work/r.err")"
+  [ "$(wc -l <"$work/r.err")" -eq 1 ] || fail "stderr is not one line for: $*: $(cat "$work/r.err")"
+  [ "$(cat "$work/r.err")" = "kushner: error: $expected" ] || fail "message for: $*: $(cat "$work/r.err") (want: $expected)"
+  [ ! -e "$work/refused" ] || fail "a refused run created its output directory: $*"
+  echo "ok: $expected"
+}

@@ -7,16 +7,6 @@ source "$(dirname "$0")/lib.sh"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
-expect_refused() {  # expect_refused "exact message" args...
-  local expected=$1; shift
-  run_kushner "$work/r" "$@" --out "$work/refused"
-  [ "$rc" -eq 2 ] || fail "exit $rc (want 2) for: $*; stderr: $(cat "$work/r.err")"
-  [ "$(wc -l <"$work/r.err")" -eq 1 ] || fail "stderr is not one line for: $*: $(cat "$work/r.err")"
-  [ "$(cat "$work/r.err")" = "kushner: error: $expected" ] || fail "message for: $*: $(cat "$work/r.err") (want: $expected)"
-  [ ! -e "$work/refused" ] || fail "a refused run created its output directory: $*"
-  echo "ok: $expected"
-}
-
 expect_refused "--dt: a discrete-time model steps k = 0, 1, ..., T; --dt must be 1 (got 0.5)" \
   filter --model clark-linear --dt 0.5
 expect_refused "--T: must be a whole number of --dt steps (T/dt = 10.5)" filter --model clark-linear --T 10.5

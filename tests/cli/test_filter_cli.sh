@@ -7,16 +7,6 @@ source "$(dirname "$0")/lib.sh"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
-expect_refused() {  # expect_refused "exact message" args...
-  local expected=$1; shift
-  run_kushner "$work/r" "$@" --out "$work/refused"
-  [ "$rc" -eq 2 ] || fail "exit $rc (want 2) for: $*; stderr: $(cat "$work/r.err")"
-  [ "$(wc -l <"$work/r.err")" -eq 1 ] || fail "stderr is not one line for: $*: $(cat "$work/r.err")"
-  [ "$(cat "$work/r.err")" = "kushner: error: $expected" ] || fail "message for: $*: $(cat "$work/r.err") (want: $expected)"
-  [ ! -e "$work/refused" ] || fail "a refused run created its output directory: $*"
-  echo "ok: $expected"
-}
-
 expect_refused "filter POLY3 does not support model 'car' (drift is not polynomial)" filter --model car --filters POLY3
 expect_refused "filter KB does not support model 'sine' (model is not linear)" filter --model sine --filters EKF,KB
 expect_refused "filter QLF does not support model 'car' (the drift has no Gaussian expectation)" filter --model car --filters QLF
