@@ -146,7 +146,7 @@ ours = lambda k: float(rows[k]["ours"])
 # KF's steady-state error variance is 0.2394 for these noises: the printed 0.240 reproduces.
 assert rows["KF/estimation_error"]["verdict"] == "reproduces", rows["KF/estimation_error"]
 assert ours("EXACT/estimation_error") < ours("MOM/estimation_error") < ours("KF/estimation_error"), rows
-assert rows["bayes_below_kf"]["verdict"] == "reproduces", rows["bayes_below_kf"]
+assert float(rows["bayes_below_kf"]["ours"].split()[0]) > 5, rows["bayes_below_kf"]  # standard errors
 # The performance column: J (no 1/2) over 1000 stages times the header's 6e-3; KF and MOM within 1% of each other.
 for k in ("KF/performance", "MOM/performance"):
     assert rows[k]["verdict"] == "reproduces", rows[k]
@@ -154,7 +154,7 @@ assert abs(ours("KF/performance") - ours("MOM/performance")) < 0.01 * ours("KF/p
 s = json.load(open(sys.argv[1] + "/summary.json"))
 assert set(s["runs"]) == {"estimation", "control"} and s["runs"]["control"]["steps"] == 1000
 t43 = table(sys.argv[2])
-low, high, se = (float(v) for v in re.findall(r"[0-9.]+", t43["kf_constant"]["ours"])[:3])
+low, high, se = (float(v) for v in re.findall(r"\d+\.\d+", t43["kf_constant"]["ours"])[:3])
 assert high - low < 4 * se, t43["kf_constant"]  # KF sees only the variance, the same for every shape
 mom = [float(t43["rho_%s/MOM" % r]["ours"]) for r in ("0", "0.1", "1", "2", "3", "7", "10")]
 assert mom[0] > 2 * mom[3], mom  # the paper's fall from rho = 0 to 2 (.138 to .067)
