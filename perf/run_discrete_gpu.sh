@@ -3,7 +3,8 @@
 #   build  build-cuda-discrete/: CUDA + OpenMP + Serial, kushner and the discrete-time tests
 #   run    test_discrete_filters on the GPU (its default space); `kushner filter` on clark-linear and
 #          linear-discrete, every discrete filter, PF and EXACT, CUDA against Serial (largest relative difference
-#          per file, and per filter); `reproduce clark-table-2.1` at 20000 members on the GPU, timed
+#          per file, and per filter); `kushner control` on clark-linear, CUDA against Serial; `reproduce
+#          clark-table-2.1` at 20000 members on the GPU, timed
 #   OUT=<dir> KUSHNER_PHASES="build run" perf/run_discrete_gpu.sh
 set -uo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
@@ -66,6 +67,19 @@ for part in ("vs truth", "vs PF"):
           {k[0]: float("%.2g" % v) for k, v in worst.items() if k[1] == part})
 PY
   done
+  log "control clark: cuda against serial (LQR with the state, KF, MOM and PF, D = 5)"
+  args=(control --model clark-linear --controllers NONE@state,LQR@state,LQR@KF,LQR@MOM,LQR@PF --cost D=5
+        --members 2000 --particles 1024 --T 100 --quiet --no-plots)
+  KUSHNER_BACKEND=cuda "$build/kushner" "${args[@]}" --out "$out/control-cuda" > "$out/control-cuda.log" 2>&1 || status=1
+  KUSHNER_BACKEND=serial "$build/kushner" "${args[@]}" --out "$out/control-serial" > "$out/control-serial.log" 2>&1 ||
+    status=1
+  python3 - "$out/control-cuda/summary.json" "$out/control-serial/summary.json" <<'PY' | tee -a "$out/steps.log"
+import json, sys
+g, h = (json.load(open(p))["controllers"] for p in sys.argv[1:3])
+for name in g:
+    print("%-10s J cuda %.12g serial %.12g rel %.2g; estimation_error %.6f" % (name, g[name]["J"], h[name]["J"],
+          abs(g[name]["J"] - h[name]["J"]) / abs(h[name]["J"]), g[name]["estimation_error"]))
+PY
   log "reproduce clark-table-2.1 at 20000 members (GPU)"
   KUSHNER_BACKEND=cuda /usr/bin/time -f "%e s wall, %M KB" "$build/kushner" reproduce clark-table-2.1 --members 20000 \
     --particles 4096 --out "$out/clark-table" --quiet --no-plots > "$out/clark-table.log" 2>&1 || status=1
