@@ -28,4 +28,13 @@ template <class Model>
 nlohmann::json run_compare_command(const Model& model, const CompareOptions& options, const OptionValues& settings,
                                    const TimeGrid& grid, const RunContext& context, const OutputDirectory& out);
 
+/// run_compare_command with the truths following `truth_model`, a model of the same type with other parameters
+/// (`kushner reproduce clark-table-4.3` gives the filters a noise law the truths do not have). Compiled with the
+/// command, so a caller compiles no bank of its own.
+template <class Model>
+nlohmann::json run_compare_with_truth_parameters(const Model& truth_model, const Model& model,
+                                                 const CompareOptions& options, const OptionValues& settings,
+                                                 const TimeGrid& grid, const RunContext& context,
+                                                 const OutputDirectory& out);
+
 }  // namespace kushner

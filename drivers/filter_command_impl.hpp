@@ -227,11 +227,22 @@ nlohmann::json run_compare_command(const Model& model, const CompareOptions& opt
   return run_compare_with_truth(model, model, options, settings, grid, context, out);
 }
 
+template <class Model>
+nlohmann::json run_compare_with_truth_parameters(const Model& truth_model, const Model& model,
+                                                 const CompareOptions& options, const OptionValues& settings,
+                                                 const TimeGrid& grid, const RunContext& context,
+                                                 const OutputDirectory& out) {
+  return run_compare_with_truth(truth_model, model, options, settings, grid, context, out);
+}
+
 }  // namespace kushner
 
 /// The explicit instantiations of the filter command for one model (the generated units of drivers/CMakeLists.txt).
-#define KUSHNER_INSTANTIATE_FILTER_COMMAND(Model)                                                              \
-  template std::vector<std::string> check_compare_options<Model>(const Model&, const CompareOptions&,          \
-                                                                 const OptionValues&);                         \
-  template nlohmann::json run_compare_command<Model>(const Model&, const CompareOptions&, const OptionValues&, \
-                                                     const TimeGrid&, const RunContext&, const OutputDirectory&);
+#define KUSHNER_INSTANTIATE_FILTER_COMMAND(Model)                                                                     \
+  template std::vector<std::string> check_compare_options<Model>(const Model&, const CompareOptions&,                 \
+                                                                 const OptionValues&);                                \
+  template nlohmann::json run_compare_command<Model>(const Model&, const CompareOptions&, const OptionValues&,        \
+                                                     const TimeGrid&, const RunContext&, const OutputDirectory&);     \
+  template nlohmann::json run_compare_with_truth_parameters<Model>(const Model&, const Model&, const CompareOptions&, \
+                                                                   const OptionValues&, const TimeGrid&,              \
+                                                                   const RunContext&, const OutputDirectory&);

@@ -6,7 +6,7 @@
 // Table 4.3: the moment filter given uniform measurement noise while the truths' has another shape of the same
 // variance, one `compare` run per shape (the bank's truths follow their own model, the filters theirs).
 #include "drivers/control_command.hpp"
-#include "drivers/filter_command_impl.hpp"
+#include "drivers/filter_command.hpp"
 #include "drivers/filter_options.hpp"
 #include "drivers/reproduce/reproduce_examples.hpp"
 #include "kernels/reference/discrete_grid_filter.hpp"
@@ -148,8 +148,8 @@ ExampleResult reproduce_clark_table_4_3(const ReproduceSettings& settings, const
     options.plots = settings.plots;
     const OutputDirectory run_out(options.run.out, "--out");
     const TimeGrid grid = make_time_grid(options.run.T, options.run.dt, options.run.output_points);
-    const nlohmann::json summary =
-        run_compare_with_truth(truth, filters_model, options, filter_option_values(options), grid, context, run_out);
+    const nlohmann::json summary = run_compare_with_truth_parameters(
+        truth, filters_model, options, filter_option_values(options), grid, context, run_out);
     result.summary["runs"][run] = summary;
     result.runs.push_back(run);
     const MeanSquare mom = mean_squared_error(summary["filters"]["MOM"], settings.T);

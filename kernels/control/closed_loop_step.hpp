@@ -2,9 +2,9 @@
 // One step of one controller's closed loop, for every member in one kernel: the law reads the member's
 // estimate at t, the cost accrues over [t, t + dt] at the left end (the rule the reference solvers use too),
 // the truth takes its Euler-Maruyama step (a discrete-time model: its transition) driven by that control, and
-// the estimator (a filter of the bank, or
-// none: the state itself, or an estimator outside the kernel such as the particle filter, which then steps on
-// the `control` this kernel stores) takes its step with the truth's dy and the known input B u. The filters are
+// the estimator (a filter of the bank, or none: the state itself, or an estimator outside the kernel such as the
+// particle filter, which then steps on the `control` this kernel stores) takes its step with the truth's dy (or
+// z[k+1]) and the known input B u. Clark's estimation-error term accrues with the running cost. The filters are
 // the model's compile-time list with at most one enabled, so each model's closed loop is one kernel whatever
 // the estimator.
 #include "kernels/control/control_law.hpp"

@@ -7,8 +7,9 @@
 //      receives p_i (F_w(b - F(x_i)) - F_w(a - F(x_i))), w's exact CDF (no sampled density: Clark's rho = 10
 //      law is zero at 0 and steep at its bounds);
 //   3. Bayes: times the likelihood's exact cell average (F_v(z - a) - F_v(z - b)) / (b - a), normalize.
-// Mean and variance treat each cell's mass as uniform on it (+ h^2/12). Its error is the grid's (O(h^2) in the
-// moments); the run reports the cells' width. One member per work item, O(G^2) per step: a reference.
+// Mean and variance treat each cell's mass as uniform on it (+ h^2/12). Its error is the grid's, O(h^2) in the
+// moments, with h at most 2 (v's bound) / G (the grid lies inside the measurement window); tests compare G and 4G.
+// One member per work item, O(G^2) per step: a reference.
 #include "core/errors.hpp"
 #include "core/math.hpp"
 #include "core/status.hpp"
@@ -27,7 +28,6 @@ struct DiscreteGridStep {
   BankScalar<double, MemSpace> lower, width;                        // (member): grid start and cell width
   BankVector<MemSpace> z, mean;
   BankSymmetric<MemSpace> covariance;
-  BankScalar<double, MemSpace> largest_width;  // (member): the widest cells so far
   BankScalar<Status, MemSpace> status;
   int cells;
   double k;
@@ -95,7 +95,6 @@ struct DiscreteGridStep {
     }
     lower(member) = new_lo;
     width(member) = new_h;
-    largest_width(member) = largest_width(member) > new_h ? largest_width(member) : new_h;
     mean(member, 0) = m;
     covariance(member, 0) = second + new_h * new_h / 12.0;
   }
@@ -118,7 +117,6 @@ class DiscreteGridFilter {
     next_ = decltype(next_)("kushner::discrete_grid_next", cells, num_members);
     lower_ = BankScalar<double, MemSpace>("kushner::discrete_grid_lower", num_members);
     width_ = BankScalar<double, MemSpace>("kushner::discrete_grid_width", num_members);
-    largest_width_ = BankScalar<double, MemSpace>("kushner::discrete_grid_largest_width", num_members);
     mean_ = BankVector<MemSpace>("kushner::discrete_grid_mean", num_members, 1);
     covariance_ = BankSymmetric<MemSpace>("kushner::discrete_grid_covariance", num_members, 1);
     status_ = BankScalar<Status, MemSpace>("kushner::discrete_grid_status", num_members);
@@ -149,14 +147,12 @@ class DiscreteGridFilter {
     KUSHNER_REQUIRE(z.extent(0) == mean_.extent(0) && z.extent_int(1) == 1, "z has the wrong shape");
     parallel_for_members("kushner::discrete_grid_step", space_, mean_.extent(0),
                          DiscreteGridStep<Model, MemSpace>{model_, mass_, next_, lower_, width_, z, mean_, covariance_,
-                                                           largest_width_, status_, cells_, static_cast<double>(k)});
+                                                           status_, cells_, static_cast<double>(k)});
   }
 
   const BankVector<MemSpace>& posterior_mean() const { return mean_; }
   const BankSymmetric<MemSpace>& posterior_covariance() const { return covariance_; }
   const BankScalar<Status, MemSpace>& status() const { return status_; }
-  /// (member): the widest cells used so far.
-  const BankScalar<double, MemSpace>& largest_cell_width() const { return largest_width_; }
   int cells() const { return cells_; }
 
  private:
@@ -164,7 +160,7 @@ class DiscreteGridFilter {
   Model model_;
   int cells_;
   Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> mass_, next_;
-  BankScalar<double, MemSpace> lower_, width_, largest_width_;
+  BankScalar<double, MemSpace> lower_, width_;
   BankVector<MemSpace> mean_;
   BankSymmetric<MemSpace> covariance_;
   BankScalar<Status, MemSpace> status_;
