@@ -5,6 +5,7 @@
 #include "core/errors.hpp"
 #include "engine/least_squares.hpp"
 #include "models/attitude_oscillation_model.hpp"
+#include "tests/input_error_expectation.hpp"
 
 #include <gtest/gtest.h>
 
@@ -19,16 +20,7 @@ namespace {
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 
-void expect_input_error(const std::function<void()>& f, const std::string& fragment) {
-  try {
-    f();
-    ADD_FAILURE() << "no InputError (expected '" << fragment << "')";
-  } catch (const InputError& e) {
-    const std::string what = e.what();
-    EXPECT_NE(what.find(fragment), std::string::npos) << what;
-    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
-  }
-}
+using test::expect_input_error;
 
 MatrixXd random_matrix(std::mt19937_64& rng, long rows, long cols) {
   std::normal_distribution<double> normal;

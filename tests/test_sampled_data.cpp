@@ -2,6 +2,7 @@
 // computed independently, and the discrete filter (2.18)-(2.19) against the Kalman-Bucy Riccati equation (2.4).
 #include "core/errors.hpp"
 #include "engine/sampled_data.hpp"
+#include "tests/input_error_expectation.hpp"
 
 #include <gtest/gtest.h>
 
@@ -35,16 +36,7 @@ MatrixXd rk4(const std::function<MatrixXd(const MatrixXd&)>& f, const MatrixXd& 
   return P + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
 }
 
-void expect_input_error(const std::function<void()>& f, const std::string& fragment) {
-  try {
-    f();
-    ADD_FAILURE() << "no InputError (expected '" << fragment << "')";
-  } catch (const InputError& e) {
-    const std::string what = e.what();
-    EXPECT_NE(what.find(fragment), std::string::npos) << what;
-    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
-  }
-}
+using test::expect_input_error;
 
 TEST(SampledData, ScalarTransitionAndNoiseMatchClosedForms) {
   for (const double a : {-0.7, 0.3, -4.0}) {
