@@ -1,6 +1,7 @@
 #pragma once
 // The subcommands of `kushner`. Each validates all its input before opening any output and throws
 // InputError for bad input; main() turns that into one line on stderr and exit code 2.
+#include "drivers/checkpoint_file.hpp"
 #include "drivers/control_options.hpp"
 #include "drivers/filter_options.hpp"
 #include "drivers/reproduce/reproduce_options.hpp"
@@ -12,12 +13,13 @@ namespace kushner {
 /// `kushner simulate`: the bank of truths; writes summary.json and timeseries.csv.
 int run_simulate(const RunOptions& options, const RunContext& context);
 
-/// `kushner filter`: the bank of truths and filters; writes summary.json and timeseries.csv.
-int run_filter(const FilterOptions& options, const RunContext& context);
+/// `kushner filter`: the bank of truths and filters; writes summary.json and timeseries.csv. Saves checkpoints
+/// (drivers/checkpoint_file.hpp) and continues from `resume` when given.
+int run_filter(const FilterOptions& options, const RunContext& context, const Checkpoint* resume = nullptr);
 
 /// `kushner compare`: `filter` with the particle reference by default, plus trajectories, density
-/// snapshots, plots and report.md.
-int run_compare(const CompareOptions& options, const RunContext& context);
+/// snapshots, plots and report.md; checkpoints as `filter`.
+int run_compare(const CompareOptions& options, const RunContext& context, const Checkpoint* resume = nullptr);
 
 /// `kushner reproduce NAME`: a worked example of the seeds run by the engine, with compare's artefacts and a
 /// table of the paper's numbers next to ours (reproduction.csv, reproduction.md, printed on stdout).

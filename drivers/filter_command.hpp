@@ -2,6 +2,7 @@
 // `kushner filter` and `kushner compare` for one model type: defined once (filter_command_impl.hpp) and
 // compiled in a few translation units, each for some of the models, so that the banks of all models build in
 // parallel. `filter` is `compare` without trajectories, density snapshots, plots and report.
+#include "drivers/checkpoint_file.hpp"
 #include "drivers/filter_options.hpp"
 #include "drivers/output_directory.hpp"
 #include "drivers/run_metadata.hpp"
@@ -23,10 +24,12 @@ std::vector<std::string> check_compare_options(const Model& model, const Compare
 
 /// Runs truths, filters, particle filter and exact filter as `options` asks, writes into `out` summary.json,
 /// timeseries.csv and, as asked, trajectories.csv, density.csv, the plots and report.md; returns the summary.
-/// Needs Kokkos initialized (KokkosSession).
+/// With options.checkpoints it saves checkpoints into `out` and continues from `resume` when given
+/// (drivers/checkpoint_file.hpp). Needs Kokkos initialized (KokkosSession).
 template <class Model>
 nlohmann::json run_compare_command(const Model& model, const CompareOptions& options, const OptionValues& settings,
-                                   const TimeGrid& grid, const RunContext& context, const OutputDirectory& out);
+                                   const TimeGrid& grid, const RunContext& context, const OutputDirectory& out,
+                                   const Checkpoint* resume = nullptr);
 
 /// run_compare_command with the truths following `truth_model`, a model of the same type with other parameters
 /// (`kushner reproduce clark-table-4.3` gives the filters a noise law the truths do not have). Compiled with the

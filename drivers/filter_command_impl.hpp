@@ -3,6 +3,7 @@
 // filter_command_*.cpp files): select and check the filters, run the bank with the particle and exact
 // references beside it, write summary.json and timeseries.csv, and for compare the chosen members'
 // trajectories, the density snapshots, the plots and report.md.
+#include "drivers/checkpoint_file.hpp"
 #include "drivers/csv.hpp"
 #include "drivers/fields_json.hpp"
 #include "drivers/filter_command.hpp"
@@ -15,6 +16,7 @@
 #include "drivers/trajectory_recorder.hpp"
 #include "engine/backend.hpp"
 #include "engine/filter_run.hpp"
+#include "engine/version.hpp"
 #include "models/parameters.hpp"
 
 #include <algorithm>
@@ -145,6 +147,32 @@ inline void add_plots(const OutputDirectory& out, nlohmann::json& summary) {
   out.write("summary.json", summary.dump(2) + "\n");
 }
 
+namespace detail {
+
+/// Everything a checkpoint's state depends on besides the code: a state saved by a run with other values (a
+/// model file or --config file changed before `kushner resume`) is refused.
+template <class Model>
+std::string run_identity(const Model& model, const CompareOptions& options, const std::vector<std::string>& filters,
+                         const ParticleSettings& particle, const std::vector<double>& density_times,
+                         const TimeGrid& grid) {
+  return nlohmann::json{{"model", model_summary(model)},
+                        {"members", options.run.members},
+                        {"seed", options.run.seed},
+                        {"dt", grid.dt},
+                        {"steps", grid.steps},
+                        {"output_steps", grid.output_steps},
+                        {"filters", filters},
+                        {"settings", options.filter_settings},
+                        {"particles", particle.particles},
+                        {"resample", options.resample},
+                        {"ess_threshold", options.ess_threshold},
+                        {"trajectory_members", options.trajectory_members},
+                        {"density_times", density_times}}
+      .dump();
+}
+
+}  // namespace detail
+
 /// No estimators beside the bank other than those named in --filters.
 struct NoExtraEstimators {
   template <class ExecSpace>
@@ -156,11 +184,14 @@ struct NoExtraEstimators {
 /// run_compare_command with the truths following `truth_model` (same dimensions as `model`, e.g. the system a
 /// Taylor model approximates, or `model` with a deterministic observation noise) and the estimators that
 /// make_extras(space) returns run beside the bank (run_filters). summary.json then also records the truths'
-/// model under "truth".
+/// model under "truth". With options.checkpoints the run saves checkpoints into `out` (on SIGINT/SIGTERM, and
+/// every options.checkpoint_every seconds when given), continues from `resume` when given, and removes its
+/// checkpoint once its results are written.
 template <class Model, class TruthModel, class MakeExtras = NoExtraEstimators>
 nlohmann::json run_compare_with_truth(const TruthModel& truth_model, const Model& model, const CompareOptions& options,
                                       const OptionValues& settings, const TimeGrid& grid, const RunContext& context,
-                                      const OutputDirectory& out, const MakeExtras& make_extras = {}) {
+                                      const OutputDirectory& out, const MakeExtras& make_extras = {},
+                                      const Checkpoint* resume = nullptr) {
   const std::vector<std::string> filters = check_compare_options<Model>(model, options, settings);
   const ParticleSettings particle = particle_settings(options);
   std::vector<double> density_times = options.density_times;
@@ -172,9 +203,26 @@ nlohmann::json run_compare_with_truth(const TruthModel& truth_model, const Model
     Progress progress(options.plots ? "compare" : "filter", progress_steps<Model>(filters, grid), !options.run.quiet);
     OutputObserver<ExecSpace, Model, TruthModel> observer;
     if (!options.trajectory_members.empty()) observer = std::ref(recorder);
+    RunCheckpointing checkpointing;
+    const std::string identity =
+        options.checkpoints ? detail::run_identity(model, options, filters, particle, density_times, grid) : "";
+    if (options.checkpoints) {
+      checkpointing.every_seconds = options.checkpoint_every_given ? options.checkpoint_every : -1.0;
+      checkpointing.resume = resume ? &resume->state : nullptr;
+      checkpointing.resume_hint = ": continue with: kushner resume " + out.path().string();
+      checkpointing.visit_caller_state = [&](StateArchive& archive) {
+        archive.require_equal("run", identity, "model or option set");
+        recorder.visit_state(archive);
+      };
+      const std::string working_directory = std::filesystem::current_path().string();
+      checkpointing.write = [&, working_directory](const std::string& state, long step, long steps) {
+        write_checkpoint(out, Checkpoint{version_string(), working_directory, context.arguments, step, steps, state});
+      };
+      catch_stop_signals();
+    }
     const FilterReport report = run_filters(
         space, truth_model, model, options.run.members, static_cast<std::uint32_t>(options.run.seed), grid, filters,
-        settings, particle, [&](long done) { progress.update(done); }, observer, make_extras(space));
+        settings, particle, [&](long done) { progress.update(done); }, observer, make_extras(space), checkpointing);
     summary = run_metadata(context);
     summary["model"] = model_summary(model);
     if constexpr (!std::is_same_v<TruthModel, Model>)
@@ -218,13 +266,15 @@ nlohmann::json run_compare_with_truth(const TruthModel& truth_model, const Model
     out.write_all(contents);  // all or none: a full disk leaves an earlier run's files as they were
   });
   if (options.plots) add_plots(out, summary);  // the plots read summary.json; it then records what they wrote
+  if (options.checkpoints) remove_checkpoint(out);
   return summary;
 }
 
 template <class Model>
 nlohmann::json run_compare_command(const Model& model, const CompareOptions& options, const OptionValues& settings,
-                                   const TimeGrid& grid, const RunContext& context, const OutputDirectory& out) {
-  return run_compare_with_truth(model, model, options, settings, grid, context, out);
+                                   const TimeGrid& grid, const RunContext& context, const OutputDirectory& out,
+                                   const Checkpoint* resume) {
+  return run_compare_with_truth(model, model, options, settings, grid, context, out, NoExtraEstimators{}, resume);
 }
 
 template <class Model>
@@ -242,7 +292,8 @@ nlohmann::json run_compare_with_truth_parameters(const Model& truth_model, const
   template std::vector<std::string> check_compare_options<Model>(const Model&, const CompareOptions&,                 \
                                                                  const OptionValues&);                                \
   template nlohmann::json run_compare_command<Model>(const Model&, const CompareOptions&, const OptionValues&,        \
-                                                     const TimeGrid&, const RunContext&, const OutputDirectory&);     \
+                                                     const TimeGrid&, const RunContext&, const OutputDirectory&,      \
+                                                     const Checkpoint*);                                              \
   template nlohmann::json run_compare_with_truth_parameters<Model>(const Model&, const Model&, const CompareOptions&, \
                                                                    const OptionValues&, const TimeGrid&,              \
                                                                    const RunContext&, const OutputDirectory&);

@@ -57,6 +57,14 @@ void add_filter_options(CLI::App& app, FilterOptions& o) {
   app.add_option("--ess-threshold", o.ess_threshold,
                  "PF resamples a member when its effective sample size falls below this fraction of --particles")
       ->capture_default_str();
+  app.add_option_function<double>(
+      "--checkpoint-every",
+      [&o](double seconds) {
+        o.checkpoint_every = seconds;
+        o.checkpoint_every_given = true;
+      },
+      "save the run's state into --out every SECONDS (0: after every step); `kushner resume DIR` continues it. "
+      "SIGINT and SIGTERM save it too");
 }
 
 void add_compare_options(CLI::App& app, CompareOptions& o) {

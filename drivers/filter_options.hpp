@@ -22,6 +22,12 @@ struct FilterOptions {
   int particles = ParticleSettings{}.particles;
   std::string resample = "systematic";
   double ess_threshold = ParticleFilterOptions{}.ess_threshold;
+  /// --checkpoint-every SECONDS: save the run's state into --out this often (`kushner resume`); < 0: not given.
+  double checkpoint_every = -1.0;
+  bool checkpoint_every_given = false;
+  /// Whether the run saves checkpoints at all (on SIGINT/SIGTERM, and every --checkpoint-every): the `filter`
+  /// and `compare` commands, not the runs `kushner reproduce` makes.
+  bool checkpoints = false;
 };
 
 /// `kushner compare`: `kushner filter`'s options plus the artefacts it writes for people to look at.
@@ -32,7 +38,7 @@ struct CompareOptions : FilterOptions {
 };
 
 /// The run options plus --filters, every filter's declared options (--gh-nodes, --asre-tolerance, ...),
-/// --particles, --resample, --ess-threshold.
+/// --particles, --resample, --ess-threshold, --checkpoint-every.
 void add_filter_options(CLI::App& app, FilterOptions& options);
 
 /// add_filter_options plus --trajectory-members, --density-times, --no-plots.

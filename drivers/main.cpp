@@ -5,6 +5,7 @@
 #include "drivers/config_file.hpp"
 #include "engine/backend.hpp"
 #include "engine/processes.hpp"
+#include "engine/run_checkpointing.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -12,6 +13,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <new>
@@ -42,6 +44,7 @@ struct Options {
   bool controllers_json = false;
   bool models_json = false;
   bool filters_json = false;
+  std::string resume_directory;
 };
 
 std::unique_ptr<CLI::App> make_app(Options& o) {
@@ -65,6 +68,11 @@ std::unique_ptr<CLI::App> make_app(Options& o) {
                                            "controllers LAW@ESTIMATOR in closed loop on the bank, scored by "
                                            "their expected cost"),
                       o.control);
+  app->add_subcommand("resume",
+                      "continue a `filter` or `compare` run from the checkpoint in its output directory "
+                      "(written every --checkpoint-every SECONDS, and on SIGINT or SIGTERM)")
+      ->add_option("DIR", o.resume_directory, "the run's --out directory")
+      ->required();
   app->add_subcommand("controllers", "list the control laws, estimators and aliases, and the models they control")
       ->add_flag("--json", o.controllers_json, "as JSON");
   app->add_subcommand("models", "list the built-in models and their parameters")
@@ -103,23 +111,51 @@ std::unique_ptr<CLI::App> parse(int argc, char** argv, Options& o) {
   return app;
 }
 
-int run(int argc, char** argv) {
+int run(int argc, char** argv, const Checkpoint* resume = nullptr);
+
+/// `kushner resume DIR`: the run of DIR's checkpoint again, with its arguments from its working directory,
+/// continued from the checkpoint's state and writing into DIR.
+int run_resume(const std::string& directory, char* program) {
+  KUSHNER_INPUT_REQUIRE(collective::ranks() == 1,
+                        "resume runs in one process: run it without mpirun (" << collective::ranks() << " ranks)");
+  const std::filesystem::path out = std::filesystem::absolute(directory);
+  const Checkpoint checkpoint = read_checkpoint(out);
+  std::error_code ec;
+  if (std::filesystem::is_directory(checkpoint.working_directory, ec))
+    std::filesystem::current_path(checkpoint.working_directory);
+  std::vector<std::string> arguments = checkpoint.arguments;
+  arguments.insert(arguments.end(), {"--out", out.string()});  // the last --out wins: DIR, wherever it moved
+  std::vector<char*> argv = {program};
+  for (auto& a : arguments) argv.push_back(a.data());
+  return run(static_cast<int>(argv.size()), argv.data(), &checkpoint);
+}
+
+/// `resume`: a run continued from a checkpoint (its argv is the checkpoint's arguments).
+int run(int argc, char** argv, const Checkpoint* resume) {
   Options o;
   const std::unique_ptr<CLI::App> app = parse(argc, argv, o);
   if (!app) return 0;
-  RunContext context{command_line(argc, argv), 0, ""};
+  // A resumed run's outputs record the command that started it (without the --out that resume appends).
+  RunContext context{command_line(resume ? argc - 2 : argc, argv), 0, "",
+                     std::vector<std::string>(argv + 1, argv + (resume ? argc - 2 : argc))};
+  if (app->got_subcommand("resume")) {
+    KUSHNER_INPUT_REQUIRE(resume == nullptr, "a checkpoint's arguments cannot be `resume`");
+    return run_resume(o.resume_directory, argv[0]);
+  }
+  KUSHNER_INPUT_REQUIRE(resume == nullptr || app->got_subcommand("filter") || app->got_subcommand("compare"),
+                        "checkpoint: of a command other than filter or compare");
   if (o.version) return run_version();
   if (app->got_subcommand("models")) return run_models(o.models_json);
   if (app->got_subcommand("filters")) return run_filters_list(o.filters_json);
   if (app->got_subcommand("filter")) {
     context.seed = static_cast<std::uint32_t>(o.filter.run.seed);
     context.backend = selected_backend();
-    return run_filter(o.filter, context);
+    return run_filter(o.filter, context, resume);
   }
   if (app->got_subcommand("compare")) {
     context.seed = static_cast<std::uint32_t>(o.compare.run.seed);
     context.backend = selected_backend();
-    return run_compare(o.compare, context);
+    return run_compare(o.compare, context, resume);
   }
   if (app->got_subcommand("controllers")) return run_controllers_list(o.controllers_json);
   if (app->got_subcommand("control")) {
@@ -167,6 +203,8 @@ std::string allocation_failure(const std::string& message) {
 std::pair<std::string, int> error_line() {
   try {
     throw;
+  } catch (const RunInterrupted& e) {
+    return {std::string("kushner: ") + e.what(), 128 + e.signal()};
   } catch (const CLI::ParseError& e) {
     return {std::string("kushner: error: ") + e.what(), 2};
   } catch (const InputError& e) {

@@ -7,13 +7,15 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace kushner {
 
 struct RunContext {
   std::string command;  // the command line, as typed (quoted where needed)
   std::uint32_t seed = 0;
-  std::string backend;  // an available_backends() name
+  std::string backend;                 // an available_backends() name
+  std::vector<std::string> arguments;  // argv[1 ..]: what a checkpoint records for `kushner resume`
 };
 
 /// {"name", "kokkos", "threads" or "device"}

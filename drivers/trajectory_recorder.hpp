@@ -123,6 +123,17 @@ class TrajectoryRecorder {
   }
   const BimodalSnapshot& most_bimodal() const { return bimodal_; }
 
+  /// What a checkpoint holds of it: the text recorded so far and where the snapshots stand.
+  void visit_state(StateArchive& archive) {
+    archive.scope = "recorder.";
+    archive.value("next_density", next_density_);
+    archive.value("most_bimodal", bimodal_);
+    archive.text("trajectories", trajectories_);
+    archive.text("density", density_);
+    archive.text("most_bimodal_rows", bimodal_rows_);
+    archive.scope.clear();
+  }
+
  private:
   template <class View>
   static auto row(const View& v, long member) {

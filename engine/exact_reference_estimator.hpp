@@ -42,6 +42,7 @@ class ExactReferenceEstimator final : public ReferenceEstimator<typename ExecSpa
   BankVector<MemSpace> mean() const override { return reference_.posterior_mean(); }
   BankSymmetric<MemSpace> covariance() const override { return reference_.posterior_covariance(); }
   BankScalar<Status, MemSpace> status() const override { return reference_.status(); }
+  void visit_state(StateArchive& archive) override { reference_.visit_state(archive); }
   Fields describe() const override {
     const auto fields = [](const char* kind, const char* note) {
       return Fields{{"kind", std::string(kind)}, {"note", std::string(note)}};

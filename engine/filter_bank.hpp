@@ -276,6 +276,33 @@ class FilterBank {
     return s;
   }
 
+  /// Saves or loads the bank's state for a checkpoint: truths, per filter its m, P, status, scores,
+  /// snapshot and own state, per outside estimator its scores (the estimators save themselves). Draws are keyed
+  /// by step, so nothing else carries from one step to the next.
+  void visit_state(StateArchive& archive) {
+    archive.scope = "truth.";
+    archive.view("x", truths_.state());
+    archive.view("observations", truths_.observations());
+    archive.view("status", truth_status_);
+    for_each_slot([&](auto& slot) {
+      using Filter = decltype(slot.filter);
+      if (!slot.enabled) return;
+      archive.scope = std::string(Filter::name) + ".";
+      archive.view("m", slot.m);
+      archive.view("P", slot.P);
+      archive.view("status", slot.status);
+      archive.view("score", slot.score);
+      archive.view("snapshot", slot.snapshot);
+      if constexpr (detail::has_own_state<Filter, StateArchive>::value) slot.filter.visit_state(archive);
+    });
+    for (auto& e : estimators_) {
+      archive.scope = e.name + ".";
+      archive.view("score", e.slot.score);
+      archive.view("snapshot", e.slot.snapshot);
+    }
+    archive.scope.clear();
+  }
+
   /// Members whose truth escaped to infinity (left out of every metric).
   long truths_escaped() const { return count_status(space_, truth_status_, Status::non_finite); }
 

@@ -13,6 +13,7 @@
 #include "engine/member_share.hpp"
 #include "engine/particle_reference.hpp"
 #include "engine/progress_callback.hpp"
+#include "engine/run_checkpointing.hpp"
 #include "engine/time_grid.hpp"
 
 #include <Kokkos_Core.hpp>
@@ -112,13 +113,18 @@ typename FilterBank<ExecSpace, Model, TruthModel>::PreparedFilters prepare_filte
 ///
 /// `members` is the whole ensemble: in a run over MPI ranks each rank runs its share (engine/member_share.hpp),
 /// and the report, the same on every rank, covers all members. `observer` sees this rank's bank.
+///
+/// `checkpointing` (engine/run_checkpointing.hpp): with a writer, the state after a step (the report so far,
+/// the bank, the outside estimators, the caller's part) is saved when its clock says so and when SIGINT or
+/// SIGTERM came (then RunInterrupted is thrown); with `resume`, the run continues from such a state. Pre-passes
+/// run again on resuming (they are deterministic).
 template <class ExecSpace, class Model, class TruthModel>
 FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, const Model& filter_model, long members,
                          std::uint32_t seed, const TimeGrid& grid, const std::vector<std::string>& filters,
                          const OptionValues& options = {}, const ParticleSettings& particle = {},
                          const ProgressCallback& progress = {},
                          const OutputObserver<ExecSpace, Model, TruthModel>& observer = {},
-                         ExtraEstimators<ExecSpace> extra = {}) {
+                         ExtraEstimators<ExecSpace> extra = {}, const RunCheckpointing& checkpointing = {}) {
   using MemSpace = typename ExecSpace::memory_space;
   const MemberShare share = member_share(members);
   const Seed rank_seed = share.seed(seed);
@@ -167,9 +173,48 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
     for (const auto& name : report.filters) report.series.back().push_back(bank.snapshot(name));
     if (observer) observer(t, bank, outside_view);
   };
-  record(0.0);
-  std::size_t next_output = 1;
-  for (long k = 0; k < grid.steps; ++k) {
+  // Everything that carries from one step to the next, in a fixed order; `step`: the steps taken.
+  const auto visit_run_state = [&](StateArchive& archive, long& step) {
+    archive.value("step", step);
+    if (checkpointing.visit_caller_state) checkpointing.visit_caller_state(archive);
+    archive.values("report.times", report.times);
+    std::vector<FilterSnapshot> series;
+    for (const auto& row : report.series) series.insert(series.end(), row.begin(), row.end());
+    archive.values("report.series", series);
+    if (archive.loading()) {
+      KUSHNER_INPUT_REQUIRE(
+          series.size() == report.times.size() * report.filters.size() && step >= 0 && step <= grid.steps,
+          "checkpoint: its report does not fit this run: written for another option set");
+      report.series.clear();
+      for (std::size_t r = 0; r < report.times.size(); ++r)
+        report.series.emplace_back(series.begin() + r * report.filters.size(),
+                                   series.begin() + (r + 1) * report.filters.size());
+    }
+    bank.visit_state(archive);
+    for (auto& e : outside) {
+      archive.scope = e->name() + ".";
+      e->visit_state(archive);
+    }
+    archive.scope.clear();
+    archive.finish();
+  };
+  long first_step = 0;
+  if (checkpointing.resume) {
+    StateArchive archive(*checkpointing.resume);
+    visit_run_state(archive, first_step);
+  } else {
+    record(0.0);
+  }
+  CheckpointClock clock(checkpointing.every_seconds);
+  const auto save = [&](long step) {
+    StateArchive archive;
+    visit_run_state(archive, step);
+    checkpointing.write(archive.bytes(), step, grid.steps);
+    clock.restart();
+  };
+  std::size_t next_output =
+      std::upper_bound(grid.output_steps.begin(), grid.output_steps.end(), first_step) - grid.output_steps.begin();
+  for (long k = first_step; k < grid.steps; ++k) {
     const bool output = next_output < grid.output_steps.size() && grid.output_steps[next_output] == k + 1;
     bank.step(k, grid.dt, output);
     if (output) {
@@ -177,6 +222,13 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
       ++next_output;
     }
     if (progress) progress(progress_base + k + 1);
+    if (!checkpointing.saves()) continue;
+    const int signal = stop_signal();
+    if (signal != 0 || (k + 1 < grid.steps && clock.due())) save(k + 1);
+    if (signal != 0)
+      throw RunInterrupted("stopped by " + signal_name(signal) + " after step " + std::to_string(k + 1) + " of " +
+                               std::to_string(grid.steps) + "; checkpoint written" + checkpointing.resume_hint,
+                           signal);
   }
   space.fence();
   for (const auto& name : report.filters) report.scores.push_back(bank.scores(name, grid.steps + 1));

@@ -263,6 +263,23 @@ class ParticleFilterBank {
   const Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace>& log_weights() const { return workspace_.cumulative; }
   const BankScalar<double, MemSpace>& log_normalizer() const { return log_normalizer_; }
 
+  /// What a checkpoint holds: the particles, their log-weights and everything a step reads from the step
+  /// before. Scratch (the resampling copy, ancestors, partial sums) is rewritten by every step, and step_pair's
+  /// second bank is not used where runs are checkpointed (the command line).
+  template <class Archive>
+  void visit_state(Archive& archive) {
+    archive.view("particles", x_);
+    archive.view("log_weights", workspace_.cumulative);
+    archive.view("log_normalizer", log_normalizer_);
+    archive.view("reference", reference_);
+    archive.view("mean", mean_);
+    archive.view("covariance", covariance_);
+    archive.view("ess", ess_);
+    archive.view("resample_now", resample_);
+    archive.view("resample_count", resample_count_);
+    archive.view("status", status_);
+  }
+
  private:
   void require_increments_shape(const BankVector<MemSpace>& dy) const {
     KUSHNER_REQUIRE(dy.extent_int(0) == num_members_ && dy.extent_int(1) == Model::obs_dim,

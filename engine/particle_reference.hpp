@@ -104,6 +104,12 @@ class ParticleReference final : public ReferenceEstimator<typename ExecSpace::me
     return ParticleSnapshot(pf_, members);
   }
 
+  void visit_state(StateArchive& archive) override {
+    pf_.visit_state(archive);
+    archive.view("ess_sums", sums_);
+    archive.value("steps", steps_);
+  }
+
   const ParticleFilterBank<ExecSpace, Model>& bank() const { return pf_; }
 
  private:

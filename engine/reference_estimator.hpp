@@ -7,6 +7,7 @@
 #include "core/fields.hpp"
 #include "core/status.hpp"
 #include "engine/particle_snapshot.hpp"
+#include "engine/state_archive.hpp"
 #include "kernels/bank.hpp"
 
 #include <optional>
@@ -40,6 +41,9 @@ class ReferenceEstimator {
   virtual BankScalar<Status, MemSpace> status() const = 0;
   /// What the summary says about it: "kind", and the estimator's own figures.
   virtual Fields describe() const = 0;
+  /// Saves or loads what a checkpoint holds of it (engine/state_archive.hpp). Estimators that only
+  /// `kushner reproduce` adds are never checkpointed.
+  virtual void visit_state(StateArchive& /*archive*/) { KUSHNER_REQUIRE(false, name() << ": cannot be checkpointed"); }
   /// For an estimator made of particles: a host copy of the chosen members' particles and weights.
   virtual std::optional<ParticleSnapshot> particle_snapshot(const std::vector<int>& /*members*/) const {
     return std::nullopt;

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # MPI across GPUs (issue 16 part 1), in phases that each fit one device call (<= 10 minutes):
 #   build  build-cuda-mpi/: CUDA + OpenMP + MPI (OpenMPI's mpirun on the GPU machine), the kushner executable
-#   run    `kushner filter --filters PF` on the sine model, N = 65536 particles, T = 2, dt = 1e-3 (2000 steps):
+#   run    `kushner filter --filters PF` on the sine model, N = 65536 particles, T = KUSHNER_T (default 2),
+#          dt = 1e-3 (1000 T steps):
 #          weak scaling  M = 1000 on 1 GPU against M = 2000 on 2 GPUs (one rank per GPU): efficiency t1 / t2
 #          strong scaling M = 2000 on 1 GPU against 2 GPUs: speedup t1 / t2
 #          the M = 2000 outputs of 1 and 2 ranks: every number equal to 1e-12 relative (and whether the bytes are)
@@ -42,7 +43,8 @@ fi
 if want run; then
   [ -x "$build/kushner" ] || { echo "no $build/kushner: run the build phase first" >&2; exit 1; }
   repetitions=${KUSHNER_REPETITIONS:-2}
-  args=(filter --model sine --filters PF --particles 65536 --T 2 --dt 1e-3 --seed 1 --output-points 20 --quiet)
+  T=${KUSHNER_T:-2}
+  args=(filter --model sine --filters PF --particles 65536 --T "$T" --dt 1e-3 --seed 1 --output-points 20 --quiet)
   nvidia-smi --query-gpu=timestamp,index,power.draw,clocks.sm,utilization.gpu --format=csv -lms 500 \
     > "$out/power.csv" 2>/dev/null &
   sampler=$!
@@ -66,11 +68,11 @@ if want run; then
   run strong_r1_m2000 1 2000
   strong_r2=weak_r2_m2000  # the same run: M = 2000 on 2 ranks
   kill "$sampler" 2>/dev/null
-  python3 - "$out" "$gpus" "$strong_r2" <<'PY' | tee "$out/summary.txt" || status=1
+  python3 - "$out" "$gpus" "$strong_r2" "$T" <<'PY' | tee "$out/summary.txt" || status=1
 import json, math, os, sys
 out, gpus, strong_r2 = sys.argv[1], int(sys.argv[2]), sys.argv[3]
 t = lambda name: float(open(os.path.join(out, name + ".time")).read())
-steps, particles = 2000, 65536
+steps, particles = round(float(sys.argv[4]) * 1000), 65536
 w1, w2, s1, s2 = t("weak_r1_m1000"), t("weak_r2_m2000"), t("strong_r1_m2000"), t(strong_r2)
 where = "2 GPUs, one rank each" if gpus >= 2 else f"{gpus} GPU: the two ranks share it (no second GPU here)"
 print(f"ranks on {where}; N = {particles}, {steps} steps, sine, kushner filter --filters PF, wall time of the command")

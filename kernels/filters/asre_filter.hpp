@@ -62,6 +62,16 @@ struct AsreFilter {
   Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> change;  // (member, iterate): max_t |m^[i] - m^[i-1]|_inf
   Iterations summary;
 
+  /// The pre-pass makes the same iterates again on resuming; they are saved anyway, so that a checkpoint
+  /// holds everything the main pass reads.
+  template <class Archive>
+  void visit_state(Archive& archive) {
+    archive.view("iterations", iterations);
+    archive.view("m", m);
+    archive.view("P", P);
+    archive.view("change", change);
+  }
+
   static std::vector<OptionSpec> options() {
     return {OptionSpec::positive_real("asre_tolerance", 1e-6,
                                       "ASRE stops iterating when max_t |m^[i](t) - m^[i-1](t)| is below this"),

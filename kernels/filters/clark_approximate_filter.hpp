@@ -34,6 +34,11 @@ struct ClarkApproximateFilter {
 
   Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> bounds;  // (member, 0: l, 1: f)
 
+  template <class Archive>
+  void visit_state(Archive& archive) {
+    archive.view("bounds", bounds);
+  }
+
   static ClarkApproximateFilter create(const OptionValues&, const Model& model, long members) {
     ClarkApproximateFilter f;
     f.bounds = decltype(f.bounds)("kushner::clark_bounds", members, 2);

@@ -44,6 +44,12 @@ struct EnsembleKalmanBucyBase {
   Seed seed;
   Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace> ensemble;  // (member, ensemble member, i)
 
+  /// The state a checkpoint holds beyond m and P (engine/state_archive.hpp).
+  template <class Archive>
+  void visit_state(Archive& archive) {
+    archive.view("ensemble", ensemble);
+  }
+
   static std::vector<OptionSpec> options() {
     return {OptionSpec::integer("enkbf_particles", 100, 2, 1 << 20,
                                 "ensemble members per bank member of EnKBF and EnKBF-S")};

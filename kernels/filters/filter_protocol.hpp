@@ -25,6 +25,9 @@
 //   static Filter create(const OptionValues&, const Model&, long members, Seed seed);  // instead of
 //                                                             // the create above: a filter that draws random
 //   static constexpr bool randomized = true;                  // numbers gets the run's seed, and says so
+//   template <class Archive> void visit_state(Archive&);      // per-member state of its own besides m, P
+//                                                             // (views): what a checkpoint must hold
+//                                                             // (archive.view(name, view): engine/state_archive.hpp)
 //
 // Filters may declare the same option (equal OptionSpec): it is one setting, shared.
 #include "core/fields.hpp"
@@ -69,6 +72,13 @@ struct has_known_input : std::false_type {};
 template <class Filter, int N>
 struct has_known_input<
     Filter, N, std::void_t<decltype(std::declval<const Filter&>().apply_known_input(0, std::declval<const Vec<N>&>()))>>
+    : std::true_type {};
+
+template <class Filter, class Archive, class = void>
+struct has_own_state : std::false_type {};
+template <class Filter, class Archive>
+struct has_own_state<Filter, Archive,
+                     std::void_t<decltype(std::declval<Filter&>().visit_state(std::declval<Archive&>()))>>
     : std::true_type {};
 
 template <class Filter, class Model, class = void>

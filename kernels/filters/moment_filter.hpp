@@ -38,6 +38,11 @@ struct MomentFilter {
   double node[nodes], weight[nodes];                           // on [-1, 1]
   Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> state;  // (member, 0: l, 1: f, 1 + j: mu_j)
 
+  template <class Archive>
+  void visit_state(Archive& archive) {
+    archive.view("bounds_and_moments", state);
+  }
+
   static std::vector<OptionSpec> options() {
     return {OptionSpec::integer("mom_order", 4, 1, max_order,
                                 "MOM: degree M of the polynomial predicted density (Clark's fourth-order filter: 4)")};

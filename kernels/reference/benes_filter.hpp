@@ -151,6 +151,16 @@ class BenesFilter {
   const BankSymmetric<MemSpace>& posterior_covariance() const { return variance_; }
   const BankScalar<Status, MemSpace>& status() const { return status_; }
 
+  /// What a checkpoint holds (engine/state_archive.hpp).
+  template <class Archive>
+  void visit_state(Archive& archive) {
+    archive.view("augmented_mean", augmented_mean_);
+    archive.view("augmented_cov", augmented_cov_);
+    archive.view("mean", mean_);
+    archive.view("variance", variance_);
+    archive.view("status", status_);
+  }
+
  private:
   void launch(const BankVector<MemSpace>& dy, double dt, bool update) {
     parallel_for_members("kushner::benes_filter_step", space_, mean_.extent(0),

@@ -155,6 +155,17 @@ class DiscreteGridFilter {
   const BankScalar<Status, MemSpace>& status() const { return status_; }
   int cells() const { return cells_; }
 
+  /// What a checkpoint holds (engine/state_archive.hpp).
+  template <class Archive>
+  void visit_state(Archive& archive) {
+    archive.view("mass", mass_);
+    archive.view("lower", lower_);
+    archive.view("width", width_);
+    archive.view("mean", mean_);
+    archive.view("covariance", covariance_);
+    archive.view("status", status_);
+  }
+
  private:
   ExecSpace space_;
   Model model_;

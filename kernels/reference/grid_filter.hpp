@@ -298,6 +298,18 @@ class GridFilter {
   const BankScalar<double, MemSpace>& min_resolution() const { return resolution_; }
   int points_per_axis() const { return n_; }
 
+  /// What a checkpoint holds (engine/state_archive.hpp).
+  template <class Archive>
+  void visit_state(Archive& archive) {
+    archive.view("mass", mass_);
+    archive.view("center", center_);
+    archive.view("spacing", spacing_);
+    archive.view("mean", mean_);
+    archive.view("covariance", covariance_);
+    archive.view("resolution", resolution_);
+    archive.view("status", status_);
+  }
+
  private:
   ExecSpace space_;
   Model model_;

@@ -92,6 +92,14 @@ class KalmanBucyReference {
   const BankSymmetric<MemSpace>& posterior_covariance() const { return covariance_; }
   const BankScalar<Status, MemSpace>& status() const { return status_; }
 
+  /// What a checkpoint holds (engine/state_archive.hpp).
+  template <class Archive>
+  void visit_state(Archive& archive) {
+    archive.view("mean", mean_);
+    archive.view("covariance", covariance_);
+    archive.view("status", status_);
+  }
+
  private:
   ExecSpace space_;
   LinearModel<N> model_;
