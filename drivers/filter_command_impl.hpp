@@ -71,17 +71,24 @@ inline nlohmann::json filter_summary(const FilterReport& report) {
   return filters;
 }
 
-/// What the run's banks allocate (the grid filter's and the recorder's smaller arrays aside).
+/// What the run's banks allocate (the recorder's small arrays aside): per member the filter bank with its
+/// filters' own state (EnKBF's ensembles, ASRE's iterates) and the exact filter (a grid's masses), per
+/// particle the particle filter.
 struct RunMemory {
   double bank_bytes_per_member = 0.0, particle_bytes_per_particle = 0.0, total_bytes = 0.0;
 };
 template <class Model>
 RunMemory run_memory(const CompareOptions& options, const std::vector<std::string>& filters,
-                     const ParticleSettings& particle) {
+                     const OptionValues& settings, const ParticleSettings& particle) {
   using Bank = FilterBank<Kokkos::DefaultHostExecutionSpace, Model>;
   using Particles = ParticleFilterBank<Kokkos::DefaultHostExecutionSpace, Model>;
   RunMemory memory;
-  memory.bank_bytes_per_member = Bank::bytes_per_member(static_cast<long>(filters.size()));
+  memory.bank_bytes_per_member =
+      Bank::bytes_per_member(static_cast<long>(filters.size())) + Bank::own_bytes_per_member(filters, settings);
+  if constexpr (has_exact_reference<Model>)
+    if (std::find(filters.begin(), filters.end(), exact_filter_name) != filters.end())
+      memory.bank_bytes_per_member +=
+          ExactReferenceEstimator<Kokkos::DefaultHostExecutionSpace, Model>::bytes_per_member();
   memory.total_bytes = static_cast<double>(options.run.members) * memory.bank_bytes_per_member;
   if (std::find(filters.begin(), filters.end(), particle_filter_name) != filters.end()) {
     memory.particle_bytes_per_particle = Particles::bytes_per_particle(particle.options);
@@ -119,7 +126,7 @@ std::vector<std::string> check_compare_options(const Model& model, const Compare
                               << std::numeric_limits<std::int32_t>::max() << ", the particle filter's index range (got "
                               << options.run.members << " x " << particle.particles << " = " << items << ")");
   }
-  const detail::RunMemory memory = detail::run_memory<Model>(options, filters, particle);
+  const detail::RunMemory memory = detail::run_memory<Model>(options, filters, settings, particle);
   std::ostringstream sizes, breakdown;
   sizes << "--members " << options.run.members;
   breakdown << "filter bank " << format_bytes(memory.bank_bytes_per_member) << " per member";
@@ -238,7 +245,7 @@ nlohmann::json run_compare_with_truth(const TruthModel& truth_model, const Model
     summary["filters"] = detail::filter_summary(report);
     summary["filter_order"] = report.filters;
     summary["truths_escaped"] = report.truths_escaped;
-    summary["memory"] = detail::memory_json(detail::run_memory<Model>(options, filters, particle));
+    summary["memory"] = detail::memory_json(detail::run_memory<Model>(options, filters, settings, particle));
     if (report.has_reference) {
       summary["reference"] = fields_json(report.estimators.at(report.reference));
       summary["reference"]["name"] = report.reference;

@@ -34,6 +34,9 @@ class ExactReferenceEstimator final : public ReferenceEstimator<typename ExecSpa
   using Reference = exact_reference_t<ExecSpace, Model>;
   static_assert(!std::is_void_v<Reference>, "ExactReferenceEstimator: the model has no exact or grid reference");
 
+  /// Bytes it allocates per member (a 2-D grid filter's masses: 256 KiB).
+  static double bytes_per_member() { return Reference::bytes_per_member(); }
+
   ExactReferenceEstimator(const ExecSpace& space, const Model& model, long members)
       : reference_(space, model, static_cast<int>(members)) {}
 

@@ -112,6 +112,19 @@ class FilterBank {
            static_cast<double>(filters) * per_filter;
   }
 
+  /// Bytes the selected filters among `filters` allocate per member for state of their own (EnKBF's ensembles,
+  /// ASRE's iterates, ...) with settings `options`, beyond bytes_per_member.
+  static double own_bytes_per_member(const std::vector<std::string>& filters, const OptionValues& options) {
+    double bytes = 0.0;
+    for_each_filter_type<Model, MemSpace>([&](auto* tag) {
+      using Filter = std::remove_pointer_t<decltype(tag)>;
+      if constexpr (detail::has_own_bytes<Filter>::value)
+        if (std::find(filters.begin(), filters.end(), Filter::name) != filters.end())
+          bytes += Filter::own_bytes_per_member(options.with_defaults(filter_options<Filter>()));
+    });
+    return bytes;
+  }
+
   /// `filters`: names of filters the model supports (supported_filters, engine/filter_catalog.hpp), in report
   /// order; `options`: their settings (declared defaults where absent). The truths follow truth_model, the
   /// filters filter_model (the same in most runs; tests set them apart to show that a test can fail, and

@@ -71,6 +71,11 @@ struct AsreFilter {
     archive.view("P", P);
     archive.view("change", change);
   }
+  /// At most: every member iterated asre_max_iterations times.
+  static double own_bytes_per_member(const OptionValues& options) {
+    const double iterates = 1.0 + static_cast<double>(options.integer("asre_max_iterations"));
+    return sizeof(int) + sizeof(double) * iterates * (n + packed_size(n) + 1);
+  }
 
   static std::vector<OptionSpec> options() {
     return {OptionSpec::positive_real("asre_tolerance", 1e-6,

@@ -38,6 +38,7 @@ struct ClarkApproximateFilter {
   void visit_state(Archive& archive) {
     archive.view("bounds", bounds);
   }
+  static double own_bytes_per_member(const OptionValues&) { return 2.0 * sizeof(double); }
 
   static ClarkApproximateFilter create(const OptionValues&, const Model& model, long members) {
     ClarkApproximateFilter f;

@@ -49,6 +49,9 @@ struct EnsembleKalmanBucyBase {
   void visit_state(Archive& archive) {
     archive.view("ensemble", ensemble);
   }
+  static double own_bytes_per_member(const OptionValues& options) {
+    return sizeof(double) * n * static_cast<double>(options.integer("enkbf_particles"));
+  }
 
   static std::vector<OptionSpec> options() {
     return {OptionSpec::integer("enkbf_particles", 100, 2, 1 << 20,

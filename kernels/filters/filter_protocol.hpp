@@ -28,6 +28,8 @@
 //   template <class Archive> void visit_state(Archive&);      // per-member state of its own besides m, P
 //                                                             // (views): what a checkpoint must hold
 //                                                             // (archive.view(name, view): engine/state_archive.hpp)
+//   static double own_bytes_per_member(const OptionValues&);  // and the bytes it allocates for it per member
+//                                                             // (the memory check before a run)
 //
 // Filters may declare the same option (equal OptionSpec): it is one setting, shared.
 #include "core/fields.hpp"
@@ -79,6 +81,12 @@ struct has_own_state : std::false_type {};
 template <class Filter, class Archive>
 struct has_own_state<Filter, Archive,
                      std::void_t<decltype(std::declval<Filter&>().visit_state(std::declval<Archive&>()))>>
+    : std::true_type {};
+
+template <class Filter, class = void>
+struct has_own_bytes : std::false_type {};
+template <class Filter>
+struct has_own_bytes<Filter, std::void_t<decltype(Filter::own_bytes_per_member(std::declval<const OptionValues&>()))>>
     : std::true_type {};
 
 template <class Filter, class Model, class = void>

@@ -42,6 +42,9 @@ struct MomentFilter {
   void visit_state(Archive& archive) {
     archive.view("bounds_and_moments", state);
   }
+  static double own_bytes_per_member(const OptionValues& options) {
+    return sizeof(double) * (2.0 + static_cast<double>(options.integer("mom_order")));
+  }
 
   static std::vector<OptionSpec> options() {
     return {OptionSpec::integer("mom_order", 4, 1, max_order,

@@ -118,6 +118,8 @@ class BenesFilter {
  public:
   using MemSpace = typename ExecSpace::memory_space;
 
+  static double bytes_per_member() { return sizeof(double) * (2 + 3 + 1 + 1) + sizeof(Status); }
+
   BenesFilter(const ExecSpace& space, const BenesModel& model, int num_members, bool truth_law = false)
       : space_(space),
         r_(model.r),

@@ -109,6 +109,10 @@ class DiscreteGridFilter {
   using MemSpace = typename ExecSpace::memory_space;
   static_assert(Model::discrete_time && Model::state_dim == 1, "DiscreteGridFilter: scalar discrete-time models");
   static constexpr int default_cells = 400;
+  /// Bytes allocated per member: the masses (two copies), the grid, the posterior.
+  static double bytes_per_member(int cells = default_cells) {
+    return sizeof(double) * (2.0 * cells + 4) + sizeof(Status);
+  }
 
   DiscreteGridFilter(const ExecSpace& space, const Model& model, int num_members, int cells = default_cells)
       : space_(space), model_(model), cells_(cells) {

@@ -217,9 +217,19 @@ class GridFilter {
   static_assert(D == 1 || D == 2, "GridFilter: state dimension 1 or 2");
   static_assert(!Model::discrete_time, "GridFilter: continuous-time models only");
 
+  static int points_per_axis(const GridOptions& options) {
+    return options.points_per_axis > 0 ? options.points_per_axis : (D == 1 ? 256 : 128);
+  }
+  /// Bytes allocated per member: the masses (two copies) and the grid's and posterior's numbers.
+  static double bytes_per_member(const GridOptions& options = {}) {
+    const double cells =
+        D == 1 ? points_per_axis(options) : static_cast<double>(points_per_axis(options)) * points_per_axis(options);
+    return sizeof(double) * (2.0 * cells + 3 * D + packed_size(D) + 1) + sizeof(Status);
+  }
+
   GridFilter(const ExecSpace& space, const Model& model, int num_members, GridOptions options = {})
       : space_(space), model_(model) {
-    n_ = options.points_per_axis > 0 ? options.points_per_axis : (D == 1 ? 256 : 128);
+    n_ = points_per_axis(options);
     half_width_ = options.half_width > 0.0 ? options.half_width : (D == 1 ? 8.0 : 7.0);
     KUSHNER_INPUT_REQUIRE(n_ >= 8, "grid: points_per_axis must be at least 8 (got " << n_ << ")");
     const Vec<D> m0 = options.truth_law ? model.x0_mean : model.prior_mean;

@@ -64,6 +64,8 @@ class KalmanBucyReference {
  public:
   using MemSpace = typename ExecSpace::memory_space;
 
+  static double bytes_per_member() { return sizeof(double) * (N + packed_size(N)) + sizeof(Status); }
+
   /// Starts every member at N(prior_mean, prior_cov) (or the truths' law when `truth_law`).
   KalmanBucyReference(const ExecSpace& space, const LinearModel<N>& model, int num_members, bool truth_law = false)
       : space_(space),

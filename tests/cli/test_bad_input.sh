@@ -73,6 +73,10 @@ expect_refused "--trajectory-members: member -1 is not in 0 .. 4" compare --memb
 if [ "$(awk '/^MemAvailable:/ {print $2}' /proc/meminfo)" -lt $((100 * 1024 * 1024)) ]; then
   expect_refused "--members 2000, --particles 1000000: the run needs 113 GiB (filter bank 331 B per member, particle filter 60 B per particle)" \
     compare --model linear --set dim=3 --members 2000 --particles 1000000 --filters EKF,PF --out "$fresh"
+  # A filter's own state counts too: EnKBF's ensembles, 10^6 particles of 8 B per member (before: an allocation
+  # failure after the run had started).
+  expect_refused "--members 20000: the run needs 149 GiB (filter bank 7.63 MiB per member)" \
+    filter --model sine --filters EnKBF --enkbf-particles 1000000 --members 20000 --out "$fresh"
 else
   echo "note: more than 100 GiB available: the memory refusal is not checked here"
 fi
