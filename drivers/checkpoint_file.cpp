@@ -1,6 +1,5 @@
 #include "drivers/checkpoint_file.hpp"
 
-#include "core/collectives.hpp"
 #include "core/errors.hpp"
 #include "engine/version.hpp"
 
