@@ -29,17 +29,22 @@ small=(--members 50 --T 0.1 --dt 0.01 --quiet)
 
 # Too little memory: the particle bank (10^8 particles, 0.8 GB a copy) cannot be allocated under a 600 MB
 # address-space limit (a limit makes malloc fail instead of waking the kernel's OOM killer; the check before
-# allocation sees the machine's free memory, which the limit does not lower).
-set +e
-(ulimit -v 600000 && exec "$kushner" filter --filters PF --members 1000 --particles 100000 --T 0.01 --dt 0.01 \
-  --out "$work/memory" --quiet) >"$work/r.out" 2>"$work/r.err"
-rc=$?
-set -e
-[ "$rc" -eq 2 ] || fail "out of memory: exit $rc (want 2): $(cat "$work/r.err")"
-[ "$(wc -l <"$work/r.err")" -eq 1 ] || fail "out of memory: stderr is not one line: $(cat "$work/r.err")"
-grep -qF "kushner: error: not enough memory: kushner::particles needs " "$work/r.err" ||
-  fail "out of memory: $(cat "$work/r.err")"
-echo "ok: $(cat "$work/r.err")"
+# allocation sees the machine's free memory, which the limit does not lower). AddressSanitizer reserves terabytes
+# of address space for its shadow memory at start, so under it (tests/sanitize/run.sh) no limit can be set.
+if ldd "$kushner" 2>/dev/null | grep -q libasan; then
+  echo "skipped: out of memory under an address-space limit (kushner is built with AddressSanitizer)"
+else
+  set +e
+  (ulimit -v 600000 && exec "$kushner" filter --filters PF --members 1000 --particles 100000 --T 0.01 --dt 0.01 \
+    --out "$work/memory" --quiet) >"$work/r.out" 2>"$work/r.err"
+  rc=$?
+  set -e
+  [ "$rc" -eq 2 ] || fail "out of memory: exit $rc (want 2): $(cat "$work/r.err")"
+  [ "$(wc -l <"$work/r.err")" -eq 1 ] || fail "out of memory: stderr is not one line: $(cat "$work/r.err")"
+  grep -qF "kushner: error: not enough memory: kushner::particles needs " "$work/r.err" ||
+    fail "out of memory: $(cat "$work/r.err")"
+  echo "ok: $(cat "$work/r.err")"
+fi
 
 # A full disk: a 64 KiB tmpfs holding an earlier run, then filled.
 if [ "$(id -u)" -eq 0 ] && mkdir "$work/disk" && mount -t tmpfs -o size=64k tmpfs "$work/disk" 2>/dev/null; then

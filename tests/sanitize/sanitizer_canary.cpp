@@ -1,0 +1,49 @@
+// A planted bug for each sanitizer of a sanitizer build (tests/sanitize/run.sh), so that its clean ctest run means
+// something: ctest expects the sanitizer's own report from each case.
+//   sanitizer_canary race       two OpenMP threads add to one double in a Kokkos kernel (ThreadSanitizer)
+//   sanitizer_canary overflow   a read one past the end of a Kokkos view's allocation (AddressSanitizer)
+//   sanitizer_canary signed     a signed integer overflow (UndefinedBehaviorSanitizer)
+#include <Kokkos_Core.hpp>
+
+#include <climits>
+#include <cstdio>
+#include <cstring>
+
+namespace {
+
+int planted_race() {
+  double sum = 0.0;
+  double* shared_sum = &sum;
+  Kokkos::parallel_for(
+      "planted_race", Kokkos::RangePolicy<Kokkos::DefaultHostExecutionSpace>(0, 4096),
+      KOKKOS_LAMBDA(int i) { *shared_sum += i; });
+  Kokkos::fence();
+  std::printf("sum %g\n", sum);
+  return 0;
+}
+
+int planted_overflow() {
+  Kokkos::View<double*, Kokkos::HostSpace> values("values", 16);
+  const double* data = values.data();
+  volatile int past_end =
+      static_cast<int>(values.extent(0));  // 16 doubles: a multiple of Kokkos' alignment, no padding
+  std::printf("value %g\n", data[past_end]);
+  return 0;
+}
+
+int planted_signed_overflow() {
+  volatile int big = INT_MAX;
+  std::printf("sum %d\n", big + 1);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char* argv[]) {
+  if (argc != 2) return 2;
+  Kokkos::ScopeGuard kokkos;
+  if (std::strcmp(argv[1], "race") == 0) return planted_race();
+  if (std::strcmp(argv[1], "overflow") == 0) return planted_overflow();
+  if (std::strcmp(argv[1], "signed") == 0) return planted_signed_overflow();
+  return 2;
+}
