@@ -172,8 +172,7 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
   }
   auto record = [&](double t) {
     report.times.push_back(t);
-    report.series.emplace_back();
-    for (const auto& name : report.filters) report.series.back().push_back(bank.snapshot(name));
+    report.series.push_back(bank.snapshots(report.filters));
     if (observer) observer(t, bank, outside_view);
   };
   // Everything that carries from one step to the next, in a fixed order; `step`: the steps taken.
