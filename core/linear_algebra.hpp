@@ -15,6 +15,17 @@ enum class Definiteness { positive_definite, singular, indefinite };
 /// indefinite; L is then partial.
 template <int N>
 KOKKOS_INLINE_FUNCTION Definiteness semidefinite_cholesky(const Mat<N, N>& A, Mat<N, N>& L, double tolerance) {
+  if constexpr (N == 1) {
+    // The loops below for N = 1, written out: GCC does not unroll a one-trip loop with several exits before it
+    // vectorizes, and a loop over members in SIMD lanes (kernels/filters/filter_slot.hpp) then fails.
+    const double a = A(0, 0);
+    const double zero = tolerance * (a > 0.0 ? a : 0.0);
+    L(0, 0) = 0.0;
+    if (!math::is_finite(a) || a < -zero) return Definiteness::indefinite;
+    if (a <= zero) return Definiteness::singular;
+    L(0, 0) = math::sqrt(a);
+    return Definiteness::positive_definite;
+  }
   double scale = 0.0;
   for (int i = 0; i < N; ++i) scale = A(i, i) > scale ? A(i, i) : scale;
   const double zero = tolerance * scale;

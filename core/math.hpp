@@ -48,6 +48,17 @@ KOKKOS_INLINE_FUNCTION double square(double v) { return v * v; }
 /// +inf (Kokkos 3.4 and 4.x both keep it in Kokkos::Experimental).
 KOKKOS_INLINE_FUNCTION constexpr double infinity() { return Kokkos::Experimental::infinity<double>::value; }
 
+/// cos(x), bit for bit, written so that GCC does not fuse it with a sin of the same x into sincos, which has no
+/// vector version: a loop over members in SIMD lanes that computes both (a filter of the sine model) would not
+/// vectorize. x + 0.0 is x except that -0 becomes +0, and cos is even. On a GPU plain cos.
+KOKKOS_INLINE_FUNCTION double cos_apart_from_sin(double x) {
+#if KUSHNER_CUDA_DEVICE_PASS
+  return cos(x);
+#else
+  return cos(x + 0.0);
+#endif
+}
+
 /// c = cos(2 pi u), s = sin(2 pi u). On a GPU CUDA's sincospi: no range reduction and one polynomial pair for
 /// both (the angle 2 pi u is never rounded); elsewhere libm's (or libmvec's) cos and sin of the rounded angle.
 KOKKOS_INLINE_FUNCTION void cos_sin_two_pi(double u, double& c, double& s) {

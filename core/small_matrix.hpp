@@ -143,8 +143,12 @@ KOKKOS_INLINE_FUNCTION Vec<R> operator*(const Mat<R, C>& m, const Vec<C>& x) {
 template <int R, int C>
 KOKKOS_INLINE_FUNCTION Mat<C, R> transpose(const Mat<R, C>& m) {
   Mat<C, R> r;
-  for (int i = 0; i < R; ++i)
-    for (int j = 0; j < C; ++j) r(j, i) = m(i, j);
+  if constexpr (R == 1 && C == 1) {  // no one-trip loop: see semidefinite_cholesky (core/linear_algebra.hpp)
+    r(0, 0) = m(0, 0);
+  } else {
+    for (int i = 0; i < R; ++i)
+      for (int j = 0; j < C; ++j) r(j, i) = m(i, j);
+  }
   return r;
 }
 /// x y^T

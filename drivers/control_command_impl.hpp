@@ -204,6 +204,7 @@ inline void print_summary(const nlohmann::json& summary, const std::string& out)
   }
   if (summary.contains("plots_error"))
     std::fprintf(stderr, "kushner: warning: %s\n", summary["plots_error"].get<std::string>().c_str());
+  if (summary.contains("timing")) print_timing(summary["timing"]);
   std::printf("written to %s/\n", out.c_str());
 }
 
@@ -293,6 +294,15 @@ nlohmann::json run_controlled_model(const Model& model, const ControlOptions& op
     summary["trace_member"] = options.trace_member;
     summary["common_random_numbers"] = true;
     summary["files"] = {"summary.json", "timeseries.csv"};
+    double loop_seconds = 0.0, particle_steps = 0.0;
+    for (const auto& run : report.controllers) {
+      loop_seconds += run.step_loop_seconds;
+      if (run.spec.estimator == particle_filter_name)
+        particle_steps += static_cast<double>(options.run.members) * grid.steps * particle.particles;
+    }
+    summary["timing"] =
+        timing_json(loop_seconds, static_cast<double>(options.run.members) * grid.steps * report.controllers.size(),
+                    particle_steps);
     out.write_all(
         {{"timeseries.csv", control_timeseries_csv(report, context, n, m)}, {"summary.json", summary.dump(2) + "\n"}});
   });
@@ -302,6 +312,7 @@ nlohmann::json run_controlled_model(const Model& model, const ControlOptions& op
     summary["plots"] = plots.ok;
     for (const auto& file : plots.files) summary["files"].push_back(file);
     if (!plots.ok) summary["plots_error"] = plots.message;
+    summary["timing"]["command_s"] = command_seconds();  // the plots included
     out.write("summary.json", summary.dump(2) + "\n");
   }
   if (!options.run.quiet) print_summary(summary, options.run.out);

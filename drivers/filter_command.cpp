@@ -32,6 +32,7 @@ void print_summary(const nlohmann::json& summary, const std::string& out) {
   }
   if (summary.contains("plots_error"))
     std::fprintf(stderr, "kushner: warning: %s\n", summary["plots_error"].get<std::string>().c_str());
+  if (summary.contains("timing")) print_timing(summary["timing"]);
   const bool report = std::any_of(summary["files"].begin(), summary["files"].end(),
                                   [](const nlohmann::json& f) { return f == "report.md"; });
   std::printf("written to %s/ (%s)\n", out.c_str(),

@@ -149,7 +149,8 @@ std::vector<std::string> check_compare_options(const Model& model, const Compare
 inline void add_plots(const OutputDirectory& out, nlohmann::json& summary) {
   const PlotResult plots = write_plots_and_report(out);
   summary["plots"] = plots.ok;
-  for (const auto& file : plots.files) summary["files"].push_back(file);  // report.md even without figures
+  for (const auto& file : plots.files) summary["files"].push_back(file);               // report.md even without figures
+  if (summary.contains("timing")) summary["timing"]["command_s"] = command_seconds();  // the plots included
   if (!plots.ok) summary["plots_error"] = plots.message;
   out.write("summary.json", summary.dump(2) + "\n");
 }
@@ -269,6 +270,10 @@ nlohmann::json run_compare_with_truth(const TruthModel& truth_model, const Model
                               {"scanned_members", bimodal.scanned_members}}}};
     }
     summary["files"] = files;
+    const bool particles = std::find(filters.begin(), filters.end(), particle_filter_name) != filters.end();
+    const double member_steps = static_cast<double>(options.run.members) * report.steps_run;
+    summary["timing"] =
+        timing_json(report.step_loop_seconds, member_steps, particles ? member_steps * particle.particles : 0.0);
     contents.emplace_back("summary.json", summary.dump(2) + "\n");
     out.write_all(contents);  // all or none: a full disk leaves an earlier run's files as they were
   });

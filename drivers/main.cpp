@@ -226,6 +226,7 @@ std::pair<std::string, int> error_line() {
 }  // namespace kushner
 
 int main(int argc, char** argv) {
+  kushner::start_command_clock();
   // A file-size limit (ulimit -f) would kill the process with SIGXFSZ mid-write, leaving a .tmp file; ignored,
   // the write fails with EFBIG instead and OutputDirectory reports it like a full disk.
   std::signal(SIGXFSZ, SIG_IGN);

@@ -24,6 +24,21 @@ nlohmann::json backend_json(const BackendDescription& description);
 /// {"command", "seed", "version", "git", "backend": describe_backend(...)}; needs Kokkos initialized.
 nlohmann::json run_metadata(const RunContext& context);
 
+/// Starts the clock of the whole command (main calls it first; otherwise the first call to command_seconds).
+void start_command_clock();
+/// Wall seconds since start_command_clock.
+double command_seconds();
+
+/// What summary.json records of a run's speed under "timing": the wall time of the step loop (main pass,
+/// fenced) and of the whole command so far, and the rates over the step loop. `member_steps`: members x
+/// steps the loop ran (every rank's members); `particle_steps`: members x particles x steps where a particle
+/// filter ran (0: none). Timing differs from run to run: tests that compare summaries byte for byte leave
+/// "timing" out as they do "backend".
+nlohmann::json timing_json(double step_loop_seconds, double member_steps, double particle_steps = 0.0);
+
+/// One line on stdout from a timing_json: the step loop's wall time and rates, the command's wall time.
+void print_timing(const nlohmann::json& timing);
+
 /// Leading comment line of CSV files: version, seed and command. The backend is in summary.json only, so
 /// that a CSV is byte-identical whichever backend computed it (the numbers are).
 std::string csv_comment(const RunContext& context);

@@ -49,6 +49,7 @@ int run_simulate(const RunOptions& given, const RunContext& context) {
       summary["var_final"] = series.moments.back().variance;
       summary["diverged"] = series.moments.back().non_finite;  // paths that escaped: left out of the moments
       summary["files"] = {"summary.json", "timeseries.csv"};
+      summary["timing"] = timing_json(series.step_loop_seconds, static_cast<double>(options.members) * grid.steps);
       out.write_all(
           {{"timeseries.csv", timeseries_csv<Model>(series, context)}, {"summary.json", summary.dump(2) + "\n"}});
     });

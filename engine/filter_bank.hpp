@@ -270,6 +270,43 @@ class FilterBank {
     return s;
   }
 
+  /// snapshot() of every filter of `names`, the same numbers, with the moments of all their snapshot columns
+  /// taken in one pass (column_moments) instead of one pass per column.
+  std::vector<FilterSnapshot> snapshots(const std::vector<std::string>& names) const {
+    using Column = Kokkos::View<const double*, MemSpace>;
+    std::vector<Column> columns;
+    std::vector<int> first;  // names[i]'s columns start at first[i]: squared error, NEES[, reference]
+    for (const auto& name : names)
+      with_slot(name, [&](const auto& slot) {
+        first.push_back(static_cast<int>(columns.size()));
+        columns.push_back(Kokkos::subview(slot.snapshot, Kokkos::ALL, int(snapshot_squared_error)));
+        columns.push_back(Kokkos::subview(slot.snapshot, Kokkos::ALL, int(snapshot_nees)));
+        if (scored_against_reference(name))
+          columns.push_back(Kokkos::subview(slot.snapshot, Kokkos::ALL, int(snapshot_reference_squared_error)));
+      });
+    const std::vector<EnsembleMoments> moments = kushner::column_moments(space_, columns);
+    std::vector<FilterSnapshot> result;
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      FilterSnapshot s;
+      const Estimate rmse = root_mean(moments[first[i]]);
+      const Estimate nees = mean(moments[first[i] + 1]);
+      const Estimate ref = scored_against_reference(names[i]) ? root_mean(moments[first[i] + 2])
+                                                              : Estimate{std::nan(""), std::nan(""), 0};
+      s.rmse_truth = rmse.value;
+      s.rmse_truth_se = rmse.standard_error;
+      s.nees = nees.value;
+      s.nees_se = nees.standard_error;
+      s.rmse_ref = ref.value;
+      s.rmse_ref_se = ref.standard_error;
+      with_slot(names[i], [&](const auto& slot) {
+        s.diverged = count_status(space_, slot.status, Status::not_positive_definite, truth_status_) +
+                     count_status(space_, slot.status, Status::non_finite, truth_status_);
+      });
+      result.push_back(s);
+    }
+    return result;
+  }
+
   /// Metrics of filter `name` over the run so far: `points` time points have been scored (steps + 1).
   FilterScores scores(const std::string& name, long points) const {
     FilterScores s;
@@ -372,14 +409,19 @@ class FilterBank {
   }
   template <class View>
   Estimate mean(const View& x, int column) const {
-    const EnsembleMoments mo = column_moments(x, column);
+    return mean(column_moments(x, column));
+  }
+  static Estimate mean(const EnsembleMoments& mo) {
     const long count = mo.members - mo.non_finite;  // over every rank
     return {mo.mean[0], count > 1 ? std::sqrt(mo.variance[0] / count) : std::nan(""), count};
   }
   /// sqrt of a mean, with the delta-method standard error se(mean) / (2 sqrt(mean)).
   template <class View>
   Estimate root_mean(const View& x, int column) const {
-    const Estimate m = mean(x, column);
+    return root_mean(column_moments(x, column));
+  }
+  static Estimate root_mean(const EnsembleMoments& mo) {
+    const Estimate m = mean(mo);
     const double root = std::sqrt(m.value);
     return {root, m.standard_error / (2.0 * root), m.members};
   }

@@ -19,6 +19,7 @@
 #include <Kokkos_Core.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -40,6 +41,8 @@ struct FilterReport {
   std::string reference;                        // the reference's name (PF, EXACT) when has_reference
   std::map<std::string, Fields> filter_fields;  // bank filter -> what it adds to its summary
   std::map<std::string, Fields> estimators;     // estimator beside the bank -> its describe()
+  double step_loop_seconds = 0.0;               // wall time of the main pass's steps (this rank; fenced)
+  long steps_run = 0;                           // steps of the main pass this process ran (fewer when resumed)
 };
 
 /// Called at t = 0 and at every output time with the bank and the outside estimators (PF, EXACT), e.g. to
@@ -169,8 +172,7 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
   }
   auto record = [&](double t) {
     report.times.push_back(t);
-    report.series.emplace_back();
-    for (const auto& name : report.filters) report.series.back().push_back(bank.snapshot(name));
+    report.series.push_back(bank.snapshots(report.filters));
     if (observer) observer(t, bank, outside_view);
   };
   // Everything that carries from one step to the next, in a fixed order; `step`: the steps taken.
@@ -214,6 +216,8 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
   };
   std::size_t next_output =
       std::upper_bound(grid.output_steps.begin(), grid.output_steps.end(), first_step) - grid.output_steps.begin();
+  space.fence();
+  const auto loop_start = std::chrono::steady_clock::now();
   for (long k = first_step; k < grid.steps; ++k) {
     const bool output = next_output < grid.output_steps.size() && grid.output_steps[next_output] == k + 1;
     bank.step(k, grid.dt, output);
@@ -231,6 +235,8 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
                            signal);
   }
   space.fence();
+  report.step_loop_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - loop_start).count();
+  report.steps_run = grid.steps - first_step;
   for (const auto& name : report.filters) report.scores.push_back(bank.scores(name, grid.steps + 1));
   for (const auto& name : bank_filters) report.filter_fields[name] = bank.summary_fields(name);
   for (const auto& e : outside) report.estimators[e->name()] = e->describe();

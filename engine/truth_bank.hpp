@@ -8,6 +8,7 @@
 #include "kernels/ensemble_moments.hpp"
 #include "kernels/simulate_truth.hpp"
 
+#include <chrono>
 #include <cstdint>
 #include <vector>
 
@@ -16,6 +17,7 @@ namespace kushner {
 struct MomentSeries {
   std::vector<double> times;
   std::vector<EnsembleMoments> moments;  // one per time
+  double step_loop_seconds = 0.0;        // wall time of the steps and moments (this rank; fenced)
 };
 
 template <class ExecSpace, class Model>
@@ -55,6 +57,8 @@ MomentSeries simulate_ensemble(const ExecSpace& space, const Model& model, long 
   TruthBank<ExecSpace, Model> bank(space, model, share.count, share.seed(seed));
   MomentSeries series;
   std::size_t next_output = 0;
+  space.fence();
+  const auto loop_start = std::chrono::steady_clock::now();
   for (long k = 0;; ++k) {
     if (next_output < grid.output_steps.size() && grid.output_steps[next_output] == k) {
       series.times.push_back(k * grid.dt);
@@ -66,6 +70,7 @@ MomentSeries simulate_ensemble(const ExecSpace& space, const Model& model, long 
     if (progress) progress(k + 1);
   }
   space.fence();
+  series.step_loop_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - loop_start).count();
   return series;
 }
 

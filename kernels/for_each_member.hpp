@@ -19,6 +19,7 @@
 
 #include <string>
 #include <type_traits>
+#include <utility>
 
 // A host function compiled once for all its callers (no inlining, no call-site specialized clones).
 #if defined(__GNUC__) && !defined(__clang__) && !defined(__CUDACC__)
@@ -34,9 +35,23 @@ namespace kushner {
 /// Members per host work item: small enough that 200 members keep 2 threads busy, large enough for SIMD.
 constexpr int host_member_chunk = 32;
 
+namespace detail {
+template <class Functor, class = void>
+struct has_run_chunk : std::false_type {};
+template <class Functor>
+struct has_run_chunk<Functor, std::void_t<decltype(std::declval<const Functor&>().run_chunk(0, 0))>> : std::true_type {
+};
+}  // namespace detail
+
+/// f(member) for the members of one chunk; a functor with a host `run_chunk(begin, end)` (the same work with
+/// member lanes in SIMD loops) runs that instead.
 template <class Functor>
 KUSHNER_SAME_CODE_FOR_ALL_CALLERS void run_member_chunk(const Functor& f, int begin, int end) {
-  for (int member = begin; member < end; ++member) f(member);
+  if constexpr (detail::has_run_chunk<Functor>::value) {
+    f.run_chunk(begin, end);
+  } else {
+    for (int member = begin; member < end; ++member) f(member);
+  }
 }
 
 template <class Functor>

@@ -5,6 +5,7 @@
 #include "core/errors.hpp"
 #include "kernels/bank.hpp"
 #include "kernels/for_each_member.hpp"
+#include "kernels/particle_filter/particle_draws.hpp"
 #include "kernels/rng.hpp"
 
 #include <Kokkos_Core.hpp>
@@ -68,17 +69,127 @@ struct EulerMaruyamaTruthStep {
 
   /// The step of one member driven by the control u over it (a closed loop's, kernels/control/).
   KOKKOS_INLINE_FUNCTION void step_member(const int member, const typename Model::Control& u) const {
-    constexpr int n = Model::state_dim, p = Model::obs_dim, q = Model::noise_dim;
-    const Vec<n> xm = load<n>(x, member);
+    constexpr int n = Model::state_dim, p = Model::obs_dim;
+    Vec<n> next;
+    Vec<p> increment;
+    next_state<Random123Draws>(member, u, load<n>(x, member), next, increment);
+    store(dy, member, increment);
+    store(x, member, next);
+  }
+
+  /// The step from x(t) = xm without storing it: x(t + dt) and dy. `Draws` says where the uniforms come from
+  /// (Random123Draws, SimdDraws: the same bits, kernels/particle_filter/particle_draws.hpp).
+  template <class Draws>
+  KOKKOS_INLINE_FUNCTION void next_state(const int member, const typename Model::Control& u,
+                                         const Vec<Model::state_dim>& xm, Vec<Model::state_dim>& next,
+                                         Vec<Model::obs_dim>& increment) const {
+    constexpr int p = Model::obs_dim, q = Model::noise_dim;
+    Vec<p> zv = Vec<p>::zero();
+    if constexpr (!has_deterministic_observation_noise<Model>)
+      zv = normals<p, Draws>(RngKey{seed, Stream::observation_noise}, member, step);
+    advance_state(u, xm, normals<q, Draws>(RngKey{seed, Stream::process_noise}, member, step), zv, next, increment);
+  }
+
+  /// The step from x(t) = xm with the standard normals zw (process noise) and zv (observation noise; unused where
+  /// the model's observation noise is a given path).
+  KOKKOS_INLINE_FUNCTION void advance_state(const typename Model::Control& u, const Vec<Model::state_dim>& xm,
+                                            const Vec<Model::noise_dim>& zw, const Vec<Model::obs_dim>& zv,
+                                            Vec<Model::state_dim>& next, Vec<Model::obs_dim>& increment) const {
+    constexpr int p = Model::obs_dim;
     const double sqrt_dt = math::sqrt(dt);
-    const Vec<q> dw = normal_vector<q>(RngKey{seed, Stream::process_noise}, member, 0, step) * sqrt_dt;
+    const auto dw = zw * sqrt_dt;
     Vec<p> dv;
     if constexpr (has_deterministic_observation_noise<Model>)
       dv = model.observation_noise_increment(t, dt);
     else
-      dv = normal_vector<p>(RngKey{seed, Stream::observation_noise}, member, 0, step) * sqrt_dt;
-    store(dy, member, model.observation(t, xm) * dt + model.observation_noise(t) * dv);
-    store(x, member, xm + model.drift(t, xm, u) * dt + model.diffusion(t, xm) * dw);
+      dv = zv * sqrt_dt;
+    increment = model.observation(t, xm) * dt + model.observation_noise(t) * dv;
+    next = xm + model.drift(t, xm, u) * dt + model.diffusion(t, xm) * dw;
+  }
+
+  /// Normals per member of a host chunk: process noise, then observation noise.
+  static constexpr int lane_draws = Model::noise_dim + Model::obs_dim;
+
+  /// Host: the chunk's normals in SIMD lanes, z[k * host_member_chunk + member - begin] for normal k of lane_draws,
+  /// with the vectorizable Philox and glibc's vector log, sqrt, sin, cos (Box-Muller). A loop of its own, with no
+  /// model code in it, so that it vectorizes for every model: the draws are then the same bits for every model,
+  /// whether or not its step vectorizes (a model file's polynomial and the built-in model it equals give the same
+  /// numbers).
+  KUSHNER_FLATTEN void draw_lanes(const int begin, const int end, double* const z) const {
+    constexpr int p = Model::obs_dim, q = Model::noise_dim;
+    draw_lane_normals<q>(begin, end, RngKey{seed, Stream::process_noise}, z);
+    if constexpr (!has_deterministic_observation_noise<Model>)
+      draw_lane_normals<p>(begin, end, RngKey{seed, Stream::observation_noise}, z + q * host_member_chunk);
+  }
+
+  /// Host: the members of one chunk in SIMD lanes (kernels/for_each_member.hpp's run_member_chunk): the draws
+  /// (draw_lanes), then the step (step_lane).
+  KUSHNER_FLATTEN void run_chunk(const int begin, const int end) const {
+    double z[lane_draws * host_member_chunk];
+    draw_lanes(begin, end, z);
+    double* const xs = x.data();  // raw pointers: GCC does not vectorize a loop that reloads a View's pointer
+    double* const dys = dy.data();
+    const std::size_t x_stride = x.stride(1), dy_stride = dy.stride(1);
+    KUSHNER_SIMD
+    for (int member = begin; member < end; ++member)
+      step_lane(member, xs, x_stride, dys, dy_stride, true, z + (member - begin));
+  }
+
+  /// One member of run_chunk: x(member) and dy(member) at xs[member + i x_stride], dys[member + i dy_stride], its
+  /// normals at z[k * host_member_chunk] (draw_lanes); `ok` false: computed but not stored (a truth that has left
+  /// the run). Returns whether x and dy are finite. The loop body is this one call with scalar arguments: a local
+  /// of the body whose address is taken (a Vec, whose operator[] is a call before inlining) becomes an `omp simd`
+  /// array, and GCC does not vectorize copies of those.
+  KOKKOS_INLINE_FUNCTION bool step_lane(const int member, double* const xs, const std::size_t x_stride,
+                                        double* const dys, const std::size_t dy_stride, const bool ok,
+                                        const double* const z) const {
+    constexpr int n = Model::state_dim, p = Model::obs_dim, q = Model::noise_dim;
+    Vec<n> xm, next;
+    Vec<p> increment, zv;
+    Vec<q> zw;
+    for (int i = 0; i < n; ++i) xm[i] = xs[member + i * x_stride];
+    for (int k = 0; k < q; ++k) zw[k] = z[k * host_member_chunk];
+    for (int k = 0; k < p; ++k) zv[k] = z[(q + k) * host_member_chunk];
+    advance_state(Model::Control::zero(), xm, zw, zv, next, increment);
+    for (int i = 0; i < p; ++i) dys[member + i * dy_stride] = ok ? increment[i] : dys[member + i * dy_stride];
+    for (int i = 0; i < n; ++i) xs[member + i * x_stride] = ok ? next[i] : xm[i];
+    return all_finite(next) && all_finite(increment);
+  }
+
+ private:
+  /// N normals per member of the chunk from `key` into z[k * host_member_chunk + member - begin].
+  template <int N>
+  void draw_lane_normals(const int begin, const int end, const RngKey& key, double* const z) const {
+    for (int i = 0; i < N; i += 2) {
+      KUSHNER_SIMD
+      for (int member = begin; member < end; ++member) {
+        const NormalPair pair = lane_normal_pair(key, member, step, i / 2);
+        z[i * host_member_chunk + member - begin] = pair.z0;
+        if (i + 1 < N) z[(i + 1) * host_member_chunk + member - begin] = pair.z1;
+      }
+    }
+  }
+  KOKKOS_INLINE_FUNCTION static NormalPair lane_normal_pair(const RngKey key, const int member,
+                                                            const std::uint32_t step, const int draw) {
+    double u0, u1;
+    SimdDraws::uniforms(key, Counter{static_cast<std::uint32_t>(member), 0, step, static_cast<std::uint32_t>(draw)}, u0,
+                        u1);
+    return box_muller(u0, u1);
+  }
+
+ private:
+  /// normal_vector's normals (blocks draw = 0 .. ceil(N/2)-1 of (member, 0, step)) from Draws' uniforms.
+  template <int N, class Draws>
+  KOKKOS_INLINE_FUNCTION static Vec<N> normals(const RngKey& key, std::uint32_t member, std::uint32_t step) {
+    Vec<N> z;
+    for (int i = 0; i < N; i += 2) {
+      double u0, u1;
+      Draws::uniforms(key, Counter{member, 0, step, static_cast<std::uint32_t>(i / 2)}, u0, u1);
+      const NormalPair pair = box_muller(u0, u1);
+      z[i] = pair.z0;
+      if (i + 1 < N) z[i + 1] = pair.z1;
+    }
+    return z;
   }
 };
 

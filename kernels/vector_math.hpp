@@ -18,3 +18,21 @@ __attribute__((simd("notinbranch"))) double exp(double) noexcept;
 __attribute__((simd("notinbranch"))) double log(double) noexcept;
 }
 #endif
+
+// `#pragma omp simd` where GCC honours it (-fopenmp or -fopenmp-simd); nothing elsewhere (nvcc's host pass).
+#define KUSHNER_PRAGMA(x) _Pragma(#x)
+#if defined(_OPENMP) || defined(KUSHNER_VECTOR_MATH)
+#define KUSHNER_SIMD KUSHNER_PRAGMA(omp simd)
+#define KUSHNER_SIMD_REDUCTION(...) KUSHNER_PRAGMA(omp simd reduction(__VA_ARGS__))
+#else
+#define KUSHNER_SIMD
+#define KUSHNER_SIMD_REDUCTION(...)
+#endif
+
+// A host function whose callees are all inlined into it (GCC vectorizes a loop only when every call in its body
+// is inlined or has a vector variant).
+#if defined(__GNUC__) && !defined(__clang__) && !defined(__CUDACC__)
+#define KUSHNER_FLATTEN __attribute__((flatten))
+#else
+#define KUSHNER_FLATTEN
+#endif

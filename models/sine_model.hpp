@@ -36,7 +36,7 @@ struct SineModel : InitialLaw<1> {
   }
   KOKKOS_INLINE_FUNCTION Mat<1, 1> control_input(double) const { return B; }
   KOKKOS_INLINE_FUNCTION Mat<1, 1> drift_jacobian(double, const Vec<1>& x, const Control&) const {
-    return {{{-math::cos(x[0])}}};
+    return {{{-math::cos_apart_from_sin(x[0])}}};
   }
   KOKKOS_INLINE_FUNCTION Mat<1, 1> drift_hessian(double, const Vec<1>& x, const Control&, int) const {
     return {{{math::sin(x[0])}}};
@@ -50,7 +50,7 @@ struct SineModel : InitialLaw<1> {
   /// Seed 000 (6.4)-(6.5): E[-sin x] = -sin(m) e^{-p/2}, E[-cos x] = -cos(m) e^{-p/2} for x ~ N(m, p).
   KOKKOS_INLINE_FUNCTION GaussianDrift<1> gaussian_drift(double, const Vec<1>& m, const Mat<1, 1>& P) const {
     const double damping = math::exp(-0.5 * P(0, 0));
-    return {{{-math::sin(m[0]) * damping}}, {{{-math::cos(m[0]) * damping}}}};
+    return {{{-math::sin(m[0]) * damping}}, {{{-math::cos_apart_from_sin(m[0]) * damping}}}};
   }
   /// -sin x = A(x) x with A(x) = -sin(x) / x (-1 at 0, its limit): the ASRE factorization.
   KOKKOS_INLINE_FUNCTION SdcDrift<1> sdc_drift(double, const Vec<1>& x) const {

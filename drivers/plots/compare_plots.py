@@ -171,6 +171,18 @@ def model_name(summary):
     return model["name"]
 
 
+def timing_line(summary):
+    """The report's line on speed, from summary.json's "timing" (None without it)."""
+    t = summary.get("timing")
+    if not t:
+        return None
+    rates = f"{t['member_steps_per_s']:.3g} member-steps/s"
+    if "particle_steps_per_s" in t:
+        rates += f", {t['particle_steps_per_s']:.3g} particle-steps/s"
+    return (f"- wall time: step loop {t['step_loop_s']:.3g} s ({rates}); whole command {t['command_s']:.3g} s "
+            "up to the results (figures not included)")
+
+
 def write_report(directory, summary, figures, no_figures=None):
     backend = summary.get("backend", {})
     where = backend.get("device") or f"{backend.get('threads', '?')} threads"
@@ -181,6 +193,8 @@ def write_report(directory, summary, figures, no_figures=None):
              f"- seed {summary['seed']}, kushner {summary['version']} (git {summary.get('git', '?')}), "
              f"backend {backend.get('name', '?')} ({where}), Kokkos {backend.get('kokkos', '?')}",
              f"- members {summary['members']}, T = {summary['T']}, dt = {summary['dt']}"]
+    if timing_line(summary):
+        lines.append(timing_line(summary))
     memory = summary.get("memory")
     if memory:
         pf = memory["particle_bytes_per_particle"]

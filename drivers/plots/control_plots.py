@@ -90,6 +90,18 @@ def plot_ranking(plt, directory, summary, colors):
     save(fig, directory, "ranking")
 
 
+def timing_line(summary):
+    """The report's line on speed, from summary.json's "timing" (None without it)."""
+    t = summary.get("timing")
+    if not t:
+        return None
+    rates = f"{t['member_steps_per_s']:.3g} member-steps/s"
+    if "particle_steps_per_s" in t:
+        rates += f", {t['particle_steps_per_s']:.3g} particle-steps/s"
+    return (f"- wall time: step loop {t['step_loop_s']:.3g} s ({rates}); whole command {t['command_s']:.3g} s "
+            "up to the results (figures not included)")
+
+
 def write_report(directory, summary, figures, no_figures=None):
     backend = summary.get("backend", {})
     where = backend.get("device") or f"{backend.get('threads', '?')} threads"
@@ -103,6 +115,8 @@ def write_report(directory, summary, figures, no_figures=None):
              f"- members {summary['members']}, T = {summary['T']}, dt = {summary['dt']}; every controller sees the "
              "same initial states and noise (common random numbers)",
              f"- cost: {cost['form']} with F = {cost['F']}, Q = {cost['Q']}, R = {cost['R']}, x* = {cost['target']}"]
+    if timing_line(summary):
+        lines.append(timing_line(summary))
     ref = summary.get("reference")
     if ref:
         lines.append(f"- reference J* = {ref['J']:.6g} ({ref['kind']}; its discretization error at most "

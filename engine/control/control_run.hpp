@@ -15,6 +15,7 @@
 
 #include <Kokkos_Core.hpp>
 
+#include <chrono>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -40,6 +41,7 @@ struct ControllerRun {
   std::vector<std::vector<double>> state_mean, control_mean;  // [time][component]
   std::vector<double> running_cost_mean;                      // mean running cost accrued up to the time
   std::vector<std::vector<double>> member_state, member_estimate, member_control;  // [time][component]
+  double step_loop_seconds = 0.0;  // wall time of the closed loop's steps (this rank; fenced)
 };
 
 struct ControlReport {
@@ -137,6 +139,8 @@ ControllerRun run_controller(const ExecSpace& space, const Model& model, long me
   };
   record(0.0);
   std::size_t next_output = 1;
+  space.fence();
+  const auto loop_start = std::chrono::steady_clock::now();
   for (long k = 0; k < grid.steps; ++k) {
     const bool output = next_output < grid.output_steps.size() && grid.output_steps[next_output] == k + 1;
     loop.step(k, grid.dt, output);
@@ -148,6 +152,7 @@ ControllerRun run_controller(const ExecSpace& space, const Model& model, long me
   }
   progress_base += grid.steps;
   space.fence();
+  run.step_loop_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - loop_start).count();
   run.cost = collective::gather(loop.member_costs());
   run.control_energy = collective::gather(loop.member_control_energy());
   run.squared_error = collective::gather(loop.member_squared_error());

@@ -8,6 +8,8 @@
 
 #include <Kokkos_Core.hpp>
 
+#include <cstdint>
+
 namespace kushner {
 
 /// The slots of a list of filters, one base class each, so that a fold expression visits all of them.
@@ -43,6 +45,112 @@ struct FilterBankStep {
     const Mat<p, p> R = model.observation_noise(truth.t);
     const StepInput<p> in{truth.t, truth.dt, dy, R * transpose(R)};
     (advance(static_cast<const FilterSlot<Filters, MemSpace>&>(slots), model, member, in, x, record), ...);
+  }
+
+  /// Host: operator() for the members [begin, end) of one chunk (kernels/for_each_member.hpp), with the members
+  /// in SIMD lanes: the truths' step first (EulerMaruyamaTruthStep::step_lane), then each filter over the chunk
+  /// (advance_lane; members are independent, so the order changes nothing). A filter whose step is not pure (own
+  /// state, random numbers) takes its step member by member as in operator(). Discrete time: operator().
+  void run_chunk(const int begin, const int end) const {
+    if constexpr (Model::discrete_time || TruthModel::discrete_time) {
+      for (int member = begin; member < end; ++member) (*this)(member);
+    } else {
+      std::int64_t live[host_member_chunk];  // 64-bit: see advance_lane
+      truth_lanes(begin, end, live);
+      const Mat<Model::obs_dim, Model::obs_dim> R = model.observation_noise(truth.t);
+      (filter_chunk(static_cast<const FilterSlot<Filters, MemSpace>&>(slots), begin, end, live, R * transpose(R)), ...);
+    }
+  }
+
+ private:
+  /// The truths of the chunk in SIMD lanes, as operator() steps them (a truth not ok is left as it is, one that
+  /// becomes non-finite is marked); live[member - begin]: the member's truth is ok after the step.
+  KUSHNER_FLATTEN void truth_lanes(const int begin, const int end, std::int64_t* live) const {
+    double z[TruthStep<TruthModel, MemSpace>::lane_draws * host_member_chunk];
+    truth.draw_lanes(begin, end, z);
+    double* const xs = truth.x.data();  // raw pointers: GCC does not vectorize a loop that reloads a View's pointer
+    double* const dys = truth.dy.data();
+    const std::size_t x_stride = truth.x.stride(1), dy_stride = truth.dy.stride(1);
+    // 64-bit flags: a one-byte Status in the loop would make GCC take 64 lanes at a time, more than a chunk.
+    for (int member = begin; member < end; ++member) live[member - begin] = truth_status(member) == Status::ok;
+    KUSHNER_SIMD
+    for (int member = begin; member < end; ++member) {
+      const bool ok = live[member - begin] != 0;
+      live[member - begin] = truth.step_lane(member, xs, x_stride, dys, dy_stride, ok, z + (member - begin)) && ok;
+    }
+    for (int member = begin; member < end; ++member)
+      if (truth_status(member) == Status::ok && !live[member - begin]) truth_status(member) = Status::non_finite;
+  }
+
+  template <class Filter>
+  void filter_chunk(const FilterSlot<Filter, MemSpace>& slot, const int begin, const int end, const std::int64_t* live,
+                    const Mat<Model::obs_dim, Model::obs_dim>& V) const {
+    constexpr int n = Model::state_dim, p = Model::obs_dim;
+    if (!slot.enabled) return;
+    if constexpr (filter_step_is_pure<Filter, n>()) {
+      const auto lanes = [&](const auto& filter) {
+        if (record)
+          filter_lanes<true>(slot, filter, begin, end, live, V);
+        else
+          filter_lanes<false>(slot, filter, begin, end, live, V);
+      };
+      if constexpr (detail::has_fixed_method<Filter>::value)
+        slot.filter.with_fixed_method(lanes);
+      else
+        lanes(slot.filter);
+    } else {
+      for (int member = begin; member < end; ++member) {
+        if (!live[member - begin]) {
+          if (record) mark_unscored(slot, member);
+          continue;
+        }
+        const StepInput<p> in{truth.t, truth.dt, load<p>(truth.dy, member), V};
+        advance(slot, model, member, in, load<n>(truth.x, member), record);
+      }
+    }
+  }
+
+  /// The lanes of slot's filter over the chunk; `stepper`: the filter, or its FixedMethod (has_fixed_method).
+  template <bool Record, class Filter, class Stepper>
+  KUSHNER_FLATTEN void filter_lanes(const FilterSlot<Filter, MemSpace>& slot, const Stepper& stepper, const int begin,
+                                    const int end, const std::int64_t* live,
+                                    const Mat<Model::obs_dim, Model::obs_dim>& V) const {
+    // Raw columns, and copies of what the lanes read through references: a copy is not reloaded after a store.
+    const Stepper filter = stepper;
+    const Model lane_model = model;
+    const Mat<Model::obs_dim, Model::obs_dim> lane_V = V;
+    double* const m = slot.m.data();
+    double* const P = slot.P.data();
+    double* const score = slot.score.data();
+    const std::size_t m_stride = slot.m.stride(1), P_stride = slot.P.stride(1), score_stride = slot.score.stride(1);
+    const double* const xs = truth.x.data();
+    const double* const dys = truth.dy.data();
+    const std::size_t x_stride = truth.x.stride(1), dy_stride = truth.dy.stride(1);
+    const double t = truth.t, dt = truth.dt;
+    std::int64_t status[host_member_chunk];  // 64-bit: see advance_lane
+    double error[host_member_chunk], nees[host_member_chunk];
+    for (int member = begin; member < end; ++member)
+      status[member - begin] = static_cast<std::int64_t>(slot.status(member));
+    KUSHNER_SIMD
+    for (int member = begin; member < end; ++member)
+      status[member - begin] =
+          advance_lane(filter, lane_model, m, m_stride, P, P_stride, score, score_stride, error + (member - begin),
+                       nees + (member - begin), status[member - begin], member, live[member - begin] != 0, t, dt,
+                       lane_V, xs, x_stride, dys, dy_stride);
+    for (int member = begin; member < end; ++member) slot.status(member) = static_cast<Status>(status[member - begin]);
+    if constexpr (Record) {
+      double* const snapshot = slot.snapshot.data();
+      const std::size_t snapshot_stride = slot.snapshot.stride(1);
+      const double nan = math::quiet_nan();
+      KUSHNER_SIMD
+      for (int member = begin; member < end; ++member) {
+        const double e = error[member - begin];
+        double& reference = snapshot[member + snapshot_reference_squared_error * snapshot_stride];
+        snapshot[member + snapshot_squared_error * snapshot_stride] = e;
+        snapshot[member + snapshot_nees * snapshot_stride] = nees[member - begin];
+        reference = e == e ? reference : nan;  // NaN error: not scored, as mark_unscored
+      }
+    }
   }
 };
 

@@ -9,6 +9,10 @@
 
 #include <Kokkos_Core.hpp>
 
+#include <cstdint>
+#include <type_traits>
+#include <utility>
+
 namespace kushner {
 
 /// Columns of FilterSlot::score: sums over the time points 0, dt, ..., t of one member's errors.
@@ -106,6 +110,92 @@ KOKKOS_INLINE_FUNCTION void advance(const FilterSlot<Filter, MemSpace>& s, const
   store(s.m, member, m);
   store_symmetric(s.P, member, P);
   score_member(s, member, x, m, L, definiteness, record);
+}
+
+namespace detail {
+/// Whether Filter offers with_fixed_method(f): f called with a filter whose step is Filter's with its run-time
+/// choices fixed at compile time (QLF's method), for loops over members in SIMD lanes.
+template <class Filter, class = void>
+struct has_fixed_method : std::false_type {};
+template <class Filter>
+struct has_fixed_method<Filter, std::void_t<decltype(std::declval<const Filter&>().with_fixed_method(
+                                    std::declval<void (*)(const typename Filter::template FixedMethod<0>&)>()))>>
+    : std::true_type {};
+}  // namespace detail
+
+/// Whether advance_lane may run Filter: its step changes nothing but the m and P it is given (no state of its
+/// own, no random numbers, no known input), so a step computed for a member and discarded is no step.
+template <class Filter, int N>
+constexpr bool filter_step_is_pure() {
+  return !detail::is_randomized<Filter>::value && !detail::has_prepass<Filter>::value &&
+         !detail::has_known_input<Filter, N>::value;
+}
+
+/// advance() of one member as one lane of a host loop over members in SIMD lanes (FilterBankStep::run_chunk): the
+/// step, the checks and the scores are computed whatever the member's state, and what advance() would store is
+/// selected, so the lanes need no branches; a frozen member (status not ok), or one whose truth is not `live`,
+/// keeps its m, P and sums. *lane_error, *lane_nees receive the member's snapshot values (NaN: not scored), which
+/// the caller stores at an output time. Returns the member's new status (`old_status`: its status before), which
+/// the caller stores too, as a 64-bit integer: a one-byte value in the loop would make GCC take 64 lanes at a time,
+/// and a store of a one-byte Status may alias anything, so GCC would reload every pointer after it. Continuous time,
+/// open loop, a filter_step_is_pure filter. The views come as raw columns and member strides (GCC does not
+/// vectorize a loop that reloads a View's pointer), and the loop body is this one call: a local of the body whose
+/// address is taken becomes an `omp simd` array, which GCC does not vectorize well. The lanes call glibc's vector sin,
+/// cos, exp, log (within 4 ulp of the scalar ones), so the last bits are those of this code, the same on every host
+/// backend and thread count.
+template <class Model, class Filter>
+KOKKOS_INLINE_FUNCTION std::int64_t advance_lane(const Filter& filter, const Model& model, double* const m_column,
+                                                 const std::size_t m_stride, double* const P_column,
+                                                 const std::size_t P_stride, double* const score,
+                                                 const std::size_t score_stride, double* const lane_error,
+                                                 double* const lane_nees, const std::int64_t old_status, int member,
+                                                 bool live, double t, double dt,
+                                                 const Mat<Model::obs_dim, Model::obs_dim>& V, const double* x,
+                                                 std::size_t x_stride, const double* dy, std::size_t dy_stride) {
+  constexpr int n = Model::state_dim, p = Model::obs_dim;
+  static_assert(!Model::discrete_time && filter_step_is_pure<Filter, n>(), "advance_lane: see filter_step_is_pure");
+  const bool stepped = live && old_status == static_cast<std::int64_t>(Status::ok);
+  Vec<n> m, xm;
+  Mat<n, n> P;
+  Vec<p> dyv;
+  for (int i = 0; i < n; ++i) m[i] = m_column[member + i * m_stride];
+  for (int i = 0; i < n; ++i)
+    for (int j = i; j < n; ++j) P(i, j) = P(j, i) = P_column[member + packed_index(n, i, j) * P_stride];
+  for (int i = 0; i < n; ++i) xm[i] = x[member + i * x_stride];
+  for (int l = 0; l < p; ++l) dyv[l] = dy[member + l * dy_stride];
+  // The status as a 64-bit integer: a one-byte value in the loop would make GCC take 64 lanes at a time.
+  std::int64_t status = static_cast<std::int64_t>(filter.step(model, member, StepInput<p>{t, dt, dyv, V}, m, P));
+  constexpr auto ok = static_cast<std::int64_t>(Status::ok);
+  m += Vec<n>::zero();  // advance()'s control shift in an open loop
+  if (status == ok && !(all_finite(m) && all_finite(P))) status = static_cast<std::int64_t>(Status::non_finite);
+  Mat<n, n> L;
+  const Definiteness definiteness = semidefinite_cholesky(P, L, covariance_tolerance);
+  if (status == ok && definiteness == Definiteness::indefinite)
+    status = static_cast<std::int64_t>(Status::not_positive_definite);
+  const bool good = stepped && status == ok;
+  for (int i = 0; i < n; ++i) {
+    double& mi = m_column[member + i * m_stride];
+    mi = good ? m[i] : mi;
+  }
+  for (int i = 0; i < n; ++i)
+    for (int j = i; j < n; ++j) {
+      double& Pij = P_column[member + packed_index(n, i, j) * P_stride];
+      Pij = good ? 0.5 * (P(i, j) + P(j, i)) : Pij;  // store_symmetric's value
+    }
+  const Vec<n> e = m - xm;
+  const double squared_error = dot(e, e);
+  const bool has_nees = good && definiteness == Definiteness::positive_definite;
+  const double nan = math::quiet_nan();
+  const double nees = has_nees ? cholesky_quadratic_form(L, e) : nan;
+  double& sum = score[member + squared_error_sum * score_stride];
+  double& nees_total = score[member + nees_sum * score_stride];
+  double& points = score[member + nees_points * score_stride];
+  sum = good ? sum + squared_error : sum;
+  nees_total = has_nees ? nees_total + nees : nees_total;
+  points = has_nees ? points + 1.0 : points;
+  *lane_error = good ? squared_error : nan;  // what the snapshot records at an output time
+  *lane_nees = nees;
+  return stepped ? status : old_status;
 }
 
 /// Time 0: the prior against the initial truth.

@@ -88,27 +88,62 @@ struct QuasiLinearFilter {
   }
 
   KOKKOS_INLINE_FUNCTION Status step(const Model& model, int, const StepInput<p>& in, Vec<n>& m, Mat<n, n>& P) const {
+    return step_with<runtime_method>(model, in, m, P);
+  }
+
+  /// QLF with its method fixed at compile time (closed_method, cubature_method): the same step without the other
+  /// method's branch, so that a loop over members in SIMD lanes (FilterBankStep::filter_lanes) vectorizes the
+  /// closed form (cubature's loop over nodes would stop it).
+  template <int Method>
+  struct FixedMethod {
+    QuasiLinearFilter filter;
+    KOKKOS_INLINE_FUNCTION Status step(const Model& model, int, const StepInput<p>& in, Vec<n>& m, Mat<n, n>& P) const {
+      return filter.template step_with<Method>(model, in, m, P);
+    }
+  };
+  /// f(FixedMethod<the method of this run>{*this}).
+  template <class F>
+  void with_fixed_method(F&& f) const {
+    if (expectations == Expectations::closed)
+      f(FixedMethod<closed_method>{*this});
+    else
+      f(FixedMethod<cubature_method>{*this});
+  }
+
+  static constexpr int runtime_method = 0, closed_method = 1, cubature_method = 2;
+
+  template <int Method>
+  KOKKOS_INLINE_FUNCTION bool closed() const {
+    if constexpr (Method == runtime_method)
+      return expectations == Expectations::closed;
+    else
+      return Method == closed_method;
+  }
+
+  template <int Method>
+  KOKKOS_INLINE_FUNCTION Status step_with(const Model& model, const StepInput<p>& in, Vec<n>& m, Mat<n, n>& P) const {
     static_assert(unsupported == nullptr, "QuasiLinearFilter: Model has no usable Gaussian expectations");
     ObservationLinearization<n, p> obs;
     // A run-time polynomial's type offers a linear observation, but its h may have terms of degree 2 and 3.
     if constexpr (ModelTraits<Model>::linear_observation && !ModelTraits<Model>::runtime_checked) {
       obs = observation_linearization(model, in.t, m);  // E_N[h] = h(m), E_N[grad h] = H exactly
-    } else if (!expected_observation(model, in.t, m, P, obs)) {
+    } else if (!expected_observation<Method>(model, in.t, m, P, obs)) {
       return Status::not_positive_definite;
     }
     Vec<p> weighted_innovation;
     if (!kalman_update(obs, in, m, P, weighted_innovation)) return Status::not_positive_definite;
     GaussianDrift<n> g;
-    if (!expected_drift(model, in.t, m, P, g)) return Status::not_positive_definite;
+    if (!expected_drift<Method>(model, in.t, m, P, g)) return Status::not_positive_definite;
     euler_predict(DriftLinearization<n>{g.mean, g.jacobian, noise_intensity(model.diffusion(in.t, m))}, in.dt, m, P);
     return Status::ok;
   }
 
   /// E_N[h], E_N[grad h] of a nonlinear observation: the model's closed form (seed 000 (5.9)-(5.10)) or cubature.
+  template <int Method = runtime_method>
   KOKKOS_INLINE_FUNCTION bool expected_observation(const Model& model, double t, const Vec<n>& m, const Mat<n, n>& P,
                                                    ObservationLinearization<n, p>& obs) const {
     if constexpr (detail::has_gaussian_observation<Model>::value) {
-      if (expectations == Expectations::closed) {
+      if (closed<Method>()) {
         const GaussianObservation<n, p> g = model.gaussian_observation(t, m, P);
         obs = ObservationLinearization<n, p>{g.mean, g.jacobian};
         return true;
@@ -118,10 +153,11 @@ struct QuasiLinearFilter {
     return false;  // unreachable: create() accepts only methods the model has
   }
 
+  template <int Method = runtime_method>
   KOKKOS_INLINE_FUNCTION bool expected_drift(const Model& model, double t, const Vec<n>& m, const Mat<n, n>& P,
                                              GaussianDrift<n>& g) const {
     if constexpr (has_closed) {
-      if (expectations == Expectations::closed) {
+      if (closed<Method>()) {
         g = closed_form_drift(model, t, m, P);
         return true;
       }

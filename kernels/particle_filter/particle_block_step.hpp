@@ -11,16 +11,6 @@
 
 #include <cstdint>
 
-// `#pragma omp simd` where GCC honours it (-fopenmp or -fopenmp-simd); nothing elsewhere (nvcc's host pass).
-#define KUSHNER_PRAGMA(x) _Pragma(#x)
-#if defined(_OPENMP) || defined(KUSHNER_VECTOR_MATH)
-#define KUSHNER_SIMD KUSHNER_PRAGMA(omp simd)
-#define KUSHNER_SIMD_REDUCTION(...) KUSHNER_PRAGMA(omp simd reduction(__VA_ARGS__))
-#else
-#define KUSHNER_SIMD
-#define KUSHNER_SIMD_REDUCTION(...)
-#endif
-
 namespace kushner {
 
 /// The host kernel's work for one block: a function of the model and the data only (not of the execution
