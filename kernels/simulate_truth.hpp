@@ -3,6 +3,7 @@
 // take an Euler-Maruyama step and produce the observation increment dy over the step; discrete-time models
 // take x[k+1] = F(k, x[k], u) + w[k] and produce z[k+1] = h(k+1, x[k+1]) + v[k+1] in the same bank.
 #include "core/errors.hpp"
+#include "core/linear_algebra.hpp"
 #include "kernels/bank.hpp"
 #include "kernels/for_each_member.hpp"
 #include "kernels/particle_filter/particle_draws.hpp"
