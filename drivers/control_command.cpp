@@ -49,7 +49,7 @@ int run_controllers_list(bool json) {
     return 0;
   }
   std::printf("Controllers are LAW@ESTIMATOR: a gain law applied to an estimate of the state.\n\nLaws:\n");
-  for (const auto& law : law_list()) std::printf("  %-6s %s\n", law.name.c_str(), law.description.c_str());
+  for (const auto& law : law_list()) std::printf("  %-8s %s\n", law.name.c_str(), law.description.c_str());
   std::printf(
       "\nEstimators: state (full information), any filter of the bank that supports the model, PF (the\n"
       "particle filter's posterior mean).\n\nAliases:\n");

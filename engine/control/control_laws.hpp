@@ -4,6 +4,9 @@
 //   NONE   no control: the plant left alone, the baseline;
 //   LQR    the affine LQR of the model linearized at the origin (engine/control/gain_laws.hpp); for a
 //          discrete-time model the discrete Riccati recursion (Clark's Riccati controller);
+//   LQR-NOM  Clark's perturbation loop (discrete time): the Riccati controller of the deviations from the
+//          noise-free optimal nominal path (engine/control/perturbation_loop.hpp); its nominal control goes to the
+//          filters linearized along the same path (KF-NOM, MOM-NOM);
 //   ASRE   Cimen & Banks' approximating sequence of Riccati equations on the nominal path (gain_laws.hpp);
 //   POLY3  Basin's polynomial regulator along its nominal path, the two-point problem solved by the sweep and by
 //          Newton (poly3_regulator.hpp);
@@ -13,6 +16,7 @@
 #include "core/fields.hpp"
 #include "engine/control/gain_laws.hpp"
 #include "engine/control/hjb_markov_chain.hpp"
+#include "engine/control/perturbation_loop.hpp"
 #include "engine/control/poly3_regulator.hpp"
 #include "engine/time_grid.hpp"
 #include "kernels/control/control_law.hpp"
@@ -33,6 +37,9 @@ struct LawInfo {
 inline std::vector<LawInfo> law_list() {
   return {{"NONE", "no control (u = 0): the uncontrolled plant, a baseline"},
           {"LQR", "linear-quadratic regulator of the model linearized at the origin, affine in the target"},
+          {"LQR-NOM",
+           "Clark's perturbation loop (discrete time): Riccati controller of the deviations from the noise-free "
+           "optimal nominal path (seed 003 (3.4)-(3.12))"},
           {"ASRE", "Cimen-Banks approximating sequence of Riccati equations (seed 001 Th. 3), on the nominal path"},
           {"POLY3",
            "Basin's polynomial regulator of degree 3 (seed 002 (16)-(17)), two-point problem by sweep and "
@@ -63,8 +70,9 @@ constexpr bool hjb_solvable() {
 template <class Model>
 const char* law_unsupported(const std::string& law) {
   if (!ModelTraits<Model>::controlled) return "the model has no control input";
-  if (Model::discrete_time && law != "NONE" && law != "LQR")
-    return "discrete time: the Riccati controller (LQR) and NONE only";
+  if (law == "LQR-NOM" && !Model::discrete_time) return "Clark's perturbation loop is for discrete-time plants";
+  if (Model::discrete_time && law != "NONE" && law != "LQR" && law != "LQR-NOM")
+    return "discrete time: the Riccati controllers (LQR, LQR-NOM) and NONE only";
   if (law == "ASRE" && !ModelTraits<Model>::sdc) return "the model has no factorization f = A(x) x + b";
   if (law == "POLY3" && !poly3_designable<Model>()) return "the drift is not a polynomial of degree <= 3";
   if (law == "HJB" && !hjb_solvable<Model>()) return "the Markov chain approximation needs dimension 1-2, one control";
@@ -76,6 +84,7 @@ template <class Model, class MemSpace>
 struct MadeLaw {
   ControlLaw<Model::state_dim, Model::control_dim, MemSpace> law;
   Fields fields;
+  std::vector<Vec<Model::control_dim>> nominal_control;  // LQR-NOM: u_bar, for the filters along its path
 };
 
 template <class Model, class MemSpace>
@@ -98,6 +107,21 @@ MadeLaw<Model, MemSpace> make_law(const std::string& name, const Model& model,
       made.fields = {{"law", std::string("LQR")},
                      {"form", std::string("discrete Riccati recursion (Clark 1971 (2.5)-(2.7))")},
                      {"linearized_at", std::string("origin")}};
+      return made;
+    }
+    if (name == "LQR-NOM") {
+      const PerturbationLoop<Model> loop = perturbation_loop(model, cost, grid.steps);
+      KUSHNER_INPUT_REQUIRE(loop.finite, "LQR-NOM: the nominal path or its Riccati recursion escapes to infinity");
+      KUSHNER_INPUT_REQUIRE(loop.converged, "LQR-NOM: the nominal path did not settle (change "
+                                                << loop.last_change << " after " << loop.iterations
+                                                << " linearizations)");
+      made.law = affine_law<n, m, MemSpace>(loop.gains);
+      made.nominal_control = loop.nominal.u;
+      made.fields = {{"law", std::string("LQR-NOM")},
+                     {"form", std::string("Riccati controller of the deviations (Clark 1971 (3.12))")},
+                     {"nominal_J", loop.nominal.J},
+                     {"nominal_x_T", loop.nominal.x.back()[0]},
+                     {"nominal_iterations", static_cast<long>(loop.iterations)}};
       return made;
     }
   } else if constexpr (ModelTraits<Model>::controlled) {

@@ -120,6 +120,12 @@ ControllerRun run_controller(const ExecSpace& space, const Model& model, long me
           Filter::prepare(options.with_defaults(filter_options<Filter>()), model, members, run_alone);
       progress_base = start + filter_prepass_passes<Filter>() * grid.steps;
     }
+    if constexpr (Filter::unsupported == nullptr && detail::follows_nominal<Filter, Model::control_dim>::value) {
+      if (spec.estimator != Filter::name || law.nominal_control.empty()) return;
+      Filter filter = create_filter<Filter>(options.with_defaults(filter_options<Filter>()), model, members, rank_seed);
+      filter.follow_nominal(law.nominal_control);  // the filter's linearization follows the law's path
+      std::get<std::optional<Filter>>(prepared) = filter;
+    }
   });
 
   Loop loop(space, model, members, rank_seed, spec.estimator, law.law, cost, options, particle, prepared);

@@ -2,7 +2,8 @@
 // The noise-free path of a controlled model under a control, on the closed loop's own discretization (issue 14):
 //   x_{k+1} = x_k + drift(t_k, x_k, u_k) dt,   t_k = k dt,   k = 0, ..., steps - 1,
 //   J = sum_k running(x_k, u_k) dt + terminal(x_steps)
-// (forward Euler; drift includes B u; the cost of kernels/control/quadratic_cost.hpp). Every deterministic solver
+// (forward Euler; drift includes B u; the cost of kernels/control/quadratic_cost.hpp); a discrete-time model takes
+// its transition x_{k+1} = F(k, x_k, u_k) instead (dt = 1). Every deterministic solver
 // of engine/control/ (POLY3's nominal path, the direct optimum) scores paths with exactly this sum, so their
 // numbers compare with each other and with the closed loop's noise-free members.
 #include "kernels/control/gain_schedule.hpp"
@@ -38,7 +39,10 @@ NominalPath<Model::state_dim, Model::control_dim> simulate_path(
     const Vec<m> u = control(k, out.x[k]);
     out.u[k] = u;
     J += cost.running(out.x[k], u) * dt;
-    out.x[k + 1] = out.x[k] + model.drift(t, out.x[k], u) * dt;
+    if constexpr (Model::discrete_time)
+      out.x[k + 1] = model.transition(t, out.x[k], u);
+    else
+      out.x[k + 1] = out.x[k] + model.drift(t, out.x[k], u) * dt;
   }
   J += cost.terminal(out.x[steps]);
   out.J = J;

@@ -9,6 +9,7 @@
 #include "kernels/filters/asre_filter.hpp"
 #include "kernels/filters/bilinear_filter.hpp"
 #include "kernels/filters/clark_approximate_filter.hpp"
+#include "kernels/filters/clark_specific_estimate.hpp"
 #include "kernels/filters/detchmendy_sridhar_filter.hpp"
 #include "kernels/filters/discrete_kalman_filter.hpp"
 #include "kernels/filters/ensemble_kalman_bucy_filter.hpp"
@@ -18,6 +19,7 @@
 #include "kernels/filters/linearized_kalman_bucy_filter.hpp"
 #include "kernels/filters/mixed_filter.hpp"
 #include "kernels/filters/moment_filter.hpp"
+#include "kernels/filters/nominal_path_filters.hpp"
 #include "kernels/filters/polynomial_filter.hpp"
 #include "kernels/filters/quasi_linear_filter.hpp"
 #include "kernels/filters/second_order_filter.hpp"
@@ -46,11 +48,11 @@ using ContinuousTimeFilters =
                EnsembleKalmanBucyFilter<Model, MemSpace>, StochasticEnsembleKalmanBucyFilter<Model, MemSpace>>;
 
 template <class Model, class MemSpace>
-using DiscreteTimeFilters =
-    std::tuple<KalmanFilter<Model, MemSpace>, InformationFilter<Model, MemSpace>,
-               ExtendedKalmanFilterD<Model, MemSpace>, MomentFilter<Model, MemSpace>,
-               ClarkMidpointFilter<Model, MemSpace>, ClarkLeastSquaresFilter<Model, MemSpace>,
-               ClarkStraightLineFilter<Model, MemSpace>, ClarkHyperbolicFilter<Model, MemSpace>>;
+using DiscreteTimeFilters = std::tuple<
+    KalmanFilter<Model, MemSpace>, InformationFilter<Model, MemSpace>, ExtendedKalmanFilterD<Model, MemSpace>,
+    MomentFilter<Model, MemSpace>, ClarkMidpointFilter<Model, MemSpace>, ClarkLeastSquaresFilter<Model, MemSpace>,
+    ClarkStraightLineFilter<Model, MemSpace>, ClarkHyperbolicFilter<Model, MemSpace>,
+    ClarkSpecificEstimate<Model, MemSpace>, NominalKalmanFilter<Model, MemSpace>, NominalMomentFilter<Model, MemSpace>>;
 
 /// The filters of Model's time (continuous or discrete): a model's filters are never compiled for the other time.
 template <class Model, class MemSpace>

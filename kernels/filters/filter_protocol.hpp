@@ -30,6 +30,8 @@
 //                                                             // (archive.view(name, view): engine/state_archive.hpp)
 //   static double own_bytes_per_member(const OptionValues&);  // and the bytes it allocates for it per member
 //                                                             // (the memory check before a run)
+//   void follow_nominal(const std::vector<Vec<m>>& u_bar);    // a filter linearized along a nominal path
+//                                                             // follows a closed loop law's (LQR-NOM's) path
 //
 // Filters may declare the same option (equal OptionSpec): it is one setting, shared.
 #include "core/fields.hpp"
@@ -101,6 +103,14 @@ template <class Filter, class = void>
 struct is_randomized : std::false_type {};
 template <class Filter>
 struct is_randomized<Filter, std::enable_if_t<Filter::randomized>> : std::true_type {};
+
+template <class Filter, int M, class = void>
+struct follows_nominal : std::false_type {};
+template <class Filter, int M>
+struct follows_nominal<
+    Filter, M,
+    std::void_t<decltype(std::declval<Filter&>().follow_nominal(std::declval<const std::vector<Vec<M>>&>()))>>
+    : std::true_type {};
 
 template <class Filter, class = void>
 struct has_summary_fields : std::false_type {};

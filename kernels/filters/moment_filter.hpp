@@ -76,9 +76,16 @@ struct MomentFilter {
   /// `known_input`: a closed loop's B u[k], part of the transition's constant term c.
   KOKKOS_INLINE_FUNCTION Status step(const Model& model, int member, const StepInput<p>& in, Vec<n>& m, Mat<n, n>& P,
                                      const Vec<n>& known_input) const {
-    const int M = order;
     const double a = model.transition_jacobian(in.t, m)(0, 0);
     const double c = model.transition(in.t, Vec<1>::zero(), Model::Control::zero())[0] + known_input[0];
+    return step_linear(model, member, in, a, c, m, P);
+  }
+
+  /// The step for the transition x[k+1] = a x + c + w, whatever gives a and c (the model's own linear
+  /// transition, or a nonlinear one linearized along a nominal path: MOM-NOM).
+  KOKKOS_INLINE_FUNCTION Status step_linear(const Model& model, int member, const StepInput<p>& in, double a, double c,
+                                            Vec<n>& m, Mat<n, n>& P) const {
+    const int M = order;
     // 1. Moments of a x + c, then of a x + c + w (odd moments of w vanish: symmetric noise).
     double mu[max_order + 1], shifted[max_order + 1], predicted[max_order + 1];
     mu[0] = 1.0;

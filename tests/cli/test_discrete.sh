@@ -15,6 +15,8 @@ expect_refused "bound_w, bound_v: must be positive (got 1, 0)" filter --model cl
 expect_refused "R: R R^T must be positive definite" filter --model linear-discrete --set 'R=1,0;0,0'
 expect_refused "filter KF does not support model 'clark-quintic' (transition is not linear)" \
   filter --model clark-quintic --filters KF
+expect_refused "filter KF-NOM does not support model 'clark-linear' (transition is linear (the nominal path changes nothing: use KF, MOM))" \
+  filter --model clark-linear --filters KF-NOM
 expect_refused "filter MOM does not support model 'linear-discrete' (state or observation is not scalar)" \
   filter --model linear-discrete --filters MOM
 expect_refused "filter EKF does not support model 'clark-linear' (a continuous-time filter; the model is discrete-time)" \
@@ -33,7 +35,7 @@ import json, sys
 s = json.load(open(sys.argv[1] + "/summary.json"))
 assert s["dt"] == 1 and s["steps"] == 20, (s["dt"], s["steps"])
 order = s["filter_order"]
-assert order == ["KF", "KF-INF", "EKF-D", "MOM", "MOM-MID", "MOM-LS", "MOM-LINE", "MOM-HYP", "PF", "EXACT"], order
+assert order == ["KF", "KF-INF", "EKF-D", "MOM", "MOM-MID", "MOM-LS", "MOM-LINE", "MOM-HYP", "MOM-SPEC", "PF", "EXACT"], order
 f = s["filters"]
 for name in order:
     assert f[name]["diverged"] == 0, (name, f[name])
@@ -47,13 +49,15 @@ print("clark-linear rmse_truth:", {n: round(f[n]["rmse_truth"], 4) for n in orde
 PY
 echo "ok: clark-linear filter run"
 
-# The nonlinear plant: EKF-D, MOM refused (nonlinear), the grid and the particle filter; the Gaussian linear model.
-"$kushner" filter --model clark-quintic --filters EKF-D,PF,EXACT --members 100 --particles 256 --T 10 --out "$work/quintic" --quiet
+# The nonlinear plant: EKF-D, KF and MOM along the nominal path (KF, MOM refused: nonlinear), the grid and the particle filter; the Gaussian linear model.
+"$kushner" filter --model clark-quintic --filters EKF-D,KF-NOM,MOM-NOM,PF,EXACT --members 100 --particles 256 --T 10 --out "$work/quintic" --quiet
 "$kushner" filter --model linear-discrete --filters all --members 100 --particles 256 --T 10 --out "$work/gauss" --quiet
 python3 - "$work/quintic" "$work/gauss" <<'PY' || fail "clark-quintic or linear-discrete run"
 import json, sys
 q = json.load(open(sys.argv[1] + "/summary.json"))
-assert q["filter_order"] == ["EKF-D", "PF", "EXACT"] and all(f["diverged"] == 0 for f in q["filters"].values())
+assert q["filter_order"] == ["EKF-D", "KF-NOM", "MOM-NOM", "PF", "EXACT"], q["filter_order"]
+assert all(f["diverged"] == 0 for f in q["filters"].values()), q["filters"]
+assert q["filters"]["KF-NOM"]["nominal"].startswith("noise-free uncontrolled"), q["filters"]["KF-NOM"]
 g = json.load(open(sys.argv[2] + "/summary.json"))
 assert g["filter_order"] == ["KF", "KF-INF", "EKF-D", "PF"], g["filter_order"]
 # On the Gaussian linear model KF is the exact filter: its distance to the particle filter is the particle
@@ -64,8 +68,10 @@ echo "ok: clark-quintic and linear-discrete runs"
 
 # kushner control: the Riccati controller with the state, KF, MOM and the particle filter, Clark's cost with the
 # estimation-error weight D; the laws a discrete model cannot take and the reference solvers are refused.
-expect_refused "--controllers: ASRE@state: law ASRE cannot control model 'clark-linear' (discrete time: the Riccati controller (LQR) and NONE only)" \
+expect_refused "--controllers: ASRE@state: law ASRE cannot control model 'clark-linear' (discrete time: the Riccati controllers (LQR, LQR-NOM) and NONE only)" \
   control --model clark-linear --controllers ASRE@state
+expect_refused "--controllers: LQR-NOM@state: law LQR-NOM cannot control model 'linear' (Clark's perturbation loop is for discrete-time plants)" \
+  control --model linear --controllers LQR-NOM@state
 expect_refused "--reference hjb: no reference solver for discrete-time models (use none)" \
   control --model clark-linear --controllers LQR@state --reference hjb
 expect_refused "--cost D: not positive semidefinite (smallest eigenvalue -1)" control --model clark-linear --controllers LQR@KF --cost D=-1
