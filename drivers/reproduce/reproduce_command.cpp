@@ -91,6 +91,7 @@ const Example examples[] = {
     {"sunahara-ex1", reproduce_sunahara_ex1, true, 10.0, 2e-3, 100, 1024},
     {"sunahara-ex2", reproduce_sunahara_ex2, true, 5.0, 2e-3, 100, 1024},
     {"clark-table-2.1", reproduce_clark_table_2_1, true, 100.0, 1.0, 500, 1024},
+    {"clark-table-3.1", reproduce_clark_table_3_1, true, 100.0, 1.0, 500, 1024},
     {"clark-table-4.3", reproduce_clark_table_4_3, true, 100.0, 1.0, 1000, 0},
     {"tarushkin-attitude", reproduce_tarushkin_attitude, true, 10800.0, 10.0, 200, 0},
 };

@@ -80,6 +80,8 @@ ExampleResult reproduce_basin_terpolymer(const ReproduceSettings& settings, cons
                                          const OutputDirectory& out);
 ExampleResult reproduce_clark_table_2_1(const ReproduceSettings& settings, const RunContext& context,
                                         const OutputDirectory& out);
+ExampleResult reproduce_clark_table_3_1(const ReproduceSettings& settings, const RunContext& context,
+                                        const OutputDirectory& out);
 ExampleResult reproduce_clark_table_4_3(const ReproduceSettings& settings, const RunContext& context,
                                         const OutputDirectory& out);
 ExampleResult reproduce_tarushkin_attitude(const ReproduceSettings& settings, const RunContext& context,

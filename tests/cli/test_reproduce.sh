@@ -162,6 +162,25 @@ print("ok: clark-table-2.1:", {k: rows[k]["ours"][:6] for k in rows if k.endswit
       "clark-table-4.3 MOM:", [round(m, 4) for m in mom])
 PY
 
+# clark-table-3.1 (seed 003 ch. III): the quintic plant in the perturbation loop, one control run per plant noise.
+run_kushner "$work/clark31" reproduce clark-table-3.1 --out "$work/clark31" --members 120 --particles 1024 \
+  --quiet --no-plots
+[ "$rc" -eq 0 ] || fail "reproduce clark-table-3.1 failed: $(cat "$work/clark31.err")"
+"$python" - "$work/clark31" <<'PY' || fail "clark-table-3.1: numbers wrong"
+import csv, json, sys
+rows = {r["key"]: r for r in csv.DictReader(l for l in open(sys.argv[1] + "/reproduction.csv") if not l.startswith("#"))}
+sigmas = ("0.05", "0.1", "0.2", "0.3", "0.545")
+err = {(s, e): float(rows["sigma_%s/%s" % (s, e)]["ours"]) for s in sigmas for e in ("KF-NOM", "MOM-NOM", "PF")}
+for e in ("KF-NOM", "MOM-NOM", "PF"):
+    assert all(err[(a, e)] < err[(b, e)] for a, b in zip(sigmas, sigmas[1:])), (e, err)  # more noise, more error
+assert err[("0.05", "MOM-NOM")] < err[("0.05", "KF-NOM")], err  # Clark's finding at low noise
+assert err[("0.05", "PF")] < 1.1 * err[("0.05", "MOM-NOM")], err  # MOM-NOM is near optimal at low noise
+s = json.load(open(sys.argv[1] + "/summary.json"))
+assert sorted(s["runs"]) == ["sigma-" + x for x in sorted(sigmas)], sorted(s["runs"])
+law = s["runs"]["sigma-0.1"]["controllers"]["LQR-NOM@KF-NOM"]
+print("ok: clark-table-3.1:", {k: round(v, 4) for k, v in err.items() if k[1] != "PF"}, law.get("law", ""))
+PY
+
 # tarushkin-attitude (seed 004 §4): batch LS = recursive LS = information filter to rounding, and the estimates
 # converge to the simulated coefficients as P predicts (50 members: NEES and RMS error within 4 standard errors).
 run_kushner "$work/tarushkin" reproduce tarushkin-attitude --out "$work/tarushkin" --members 50 --quiet --no-plots
@@ -284,7 +303,7 @@ expect_refused() {  # expect_refused "message fragment" args...: one line, exit 
   [ ! -e "$work/refused" ] || fail "a refused run created its output directory: $*"
   echo "ok: $(cat "$work/r.err")"
 }
-expect_refused "reproduce: unknown example 'basin-car' (known: basin-car-filter, basin-terpolymer, basin-car-regulator, basin-regulator-enotes, basin-car-controller, sunahara-ex1, sunahara-ex2, clark-table-2.1, clark-table-4.3, tarushkin-attitude)" \
+expect_refused "reproduce: unknown example 'basin-car' (known: basin-car-filter, basin-terpolymer, basin-car-regulator, basin-regulator-enotes, basin-car-controller, sunahara-ex1, sunahara-ex2, clark-table-2.1, clark-table-3.1, clark-table-4.3, tarushkin-attitude)" \
   reproduce basin-car --out "$work/refused"
 expect_refused "--out is required" reproduce basin-car-filter
 expect_refused "--members: basin-car-filter is deterministic" reproduce basin-car-filter --members 10 --out "$work/refused"
