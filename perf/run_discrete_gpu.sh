@@ -3,7 +3,8 @@
 #   build  build-cuda-discrete/: CUDA + OpenMP + Serial, kushner and the discrete-time tests
 #   run    test_discrete_filters on the GPU (its default space); `kushner filter` on clark-linear and
 #          linear-discrete, every discrete filter, PF and EXACT, CUDA against Serial (largest relative difference
-#          per file, and per filter); `kushner control` on clark-linear, CUDA against Serial; `reproduce
+#          per file, and per filter), and clark-quintic (KF-NOM, MOM-NOM along the nominal path); `kushner control` on
+#          clark-linear (with MOM-SPEC) and clark-quintic (the perturbation loop LQR-NOM), CUDA against Serial; `reproduce
 #          clark-table-2.1` at 20000 members on the GPU, timed
 #   OUT=<dir> KUSHNER_PHASES="build run" perf/run_discrete_gpu.sh
 set -uo pipefail
@@ -21,7 +22,7 @@ nvidia-smi --query-gpu=name,memory.total,power.limit,clocks.max.sm,driver_versio
 if want build; then
   log "configure"
   cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON -DKUSHNER_ENABLE_OPENMP=ON \
-    -DKUSHNER_ENABLE_SERIAL=ON -DKUSHNER_ENABLE_MPI=OFF > "$out/configure.log" 2>&1 || { tail -20 "$out/configure.log"; exit 1; }
+    -DKUSHNER_ENABLE_SERIAL=ON -DKUSHNER_ENABLE_MPI=OFF -DKUSHNER_COMMAND_UNITS=16 > "$out/configure.log" 2>&1 || { tail -20 "$out/configure.log"; exit 1; }
   log "common libraries"
   cmake --build "$build" -j16 --target kushner_test_main kushner_driver > "$out/build_common.log" 2>&1 ||
     { grep -B2 -A10 -m3 "error" "$out/build_common.log"; exit 1; }
@@ -43,7 +44,8 @@ if want run; then
   "$build/tests/test_discrete_control" > "$out/test_discrete_control.log" 2>&1 || status=1
   grep -E "OK \]|FAILED|PASSED|J =|D =" "$out/test_discrete_control.log"
   for run in "clark --model clark-linear --filters all,EXACT --members 500 --particles 1024 --T 50 --seed 11" \
-             "gauss --model linear-discrete --filters all --members 2000 --particles 1024 --T 50 --seed 12"; do
+             "gauss --model linear-discrete --filters all --members 2000 --particles 1024 --T 50 --seed 12" \
+             "quintic --model clark-quintic --filters all,EXACT --members 1000 --particles 1024 --T 50 --seed 13 --set bound_w=0.3"; do
     set -- $run
     name=$1; shift
     log "filter $name: cuda against serial"
@@ -67,23 +69,31 @@ for part in ("vs truth", "vs PF"):
           {k[0]: float("%.2g" % v) for k, v in worst.items() if k[1] == part})
 PY
   done
-  log "control clark: cuda against serial (LQR with the state, KF, MOM and PF, D = 5)"
-  args=(control --model clark-linear --controllers NONE@state,LQR@state,LQR@KF,LQR@MOM,LQR@PF --cost D=5
-        --members 2000 --particles 1024 --T 100 --quiet --no-plots)
-  KUSHNER_BACKEND=cuda "$build/kushner" "${args[@]}" --out "$out/control-cuda" > "$out/control-cuda.log" 2>&1 || status=1
-  KUSHNER_BACKEND=serial "$build/kushner" "${args[@]}" --out "$out/control-serial" > "$out/control-serial.log" 2>&1 ||
+  for run in "control --model clark-linear --controllers NONE@state,LQR@state,LQR@KF,LQR@MOM,LQR@MOM-SPEC,LQR@PF --cost D=5" \
+             "control-quintic --model clark-quintic --controllers LQR-NOM@KF-NOM,LQR-NOM@MOM-NOM,LQR-NOM@PF --set bound_w=0.3 --set x0_mean=2 --set prior_mean=2"; do
+  set -- $run
+  name=$1; shift
+  log "$name: cuda against serial"
+  args=(control "$@" --members 2000 --particles 1024 --T 100 --quiet --no-plots)
+  KUSHNER_BACKEND=cuda "$build/kushner" "${args[@]}" --out "$out/$name-cuda" > "$out/$name-cuda.log" 2>&1 || status=1
+  KUSHNER_BACKEND=serial "$build/kushner" "${args[@]}" --out "$out/$name-serial" > "$out/$name-serial.log" 2>&1 ||
     status=1
-  python3 - "$out/control-cuda/summary.json" "$out/control-serial/summary.json" <<'PY' | tee -a "$out/steps.log"
+  python3 - "$out/$name-cuda/summary.json" "$out/$name-serial/summary.json" <<'PY' | tee -a "$out/steps.log"
 import json, sys
 g, h = (json.load(open(p))["controllers"] for p in sys.argv[1:3])
 for name in g:
     print("%-10s J cuda %.12g serial %.12g rel %.2g; estimation_error %.6f" % (name, g[name]["J"], h[name]["J"],
           abs(g[name]["J"] - h[name]["J"]) / abs(h[name]["J"]), g[name]["estimation_error"]))
 PY
+  done
   log "reproduce clark-table-2.1 at 20000 members (GPU)"
   KUSHNER_BACKEND=cuda /usr/bin/time -f "%e s wall, %M KB" "$build/kushner" reproduce clark-table-2.1 --members 20000 \
     --particles 4096 --out "$out/clark-table" --quiet --no-plots > "$out/clark-table.log" 2>&1 || status=1
   tail -25 "$out/clark-table.log"
+  log "reproduce clark-table-3.1 (GPU)"
+  KUSHNER_BACKEND=cuda /usr/bin/time -f "%e s wall, %M KB" "$build/kushner" reproduce clark-table-3.1 --members 20000 \
+    --particles 1024 --out "$out/clark-table-3.1" --quiet --no-plots > "$out/clark-table-3.1.log" 2>&1 || status=1
+  tail -25 "$out/clark-table-3.1.log"
   log "done (status $status)"
 fi
 exit $status

@@ -1,0 +1,100 @@
+#!/usr/bin/env python3
+"""The filter bank of `kushner filter --model sine --filters EKF,SOF,QLF,KBL` in JAX (issue 16 part 4's GPU
+comparison): arrays over members, the step loop as one `lax.scan`, fp64, the equations of perf/bank_numpy.py
+(truth by Euler-Maruyama, then every filter's update and prediction with the truth's dy), normals from
+jax.random drawn inside the scan (one key split per step), no metrics. Compilation is excluded: each T is run once
+to compile, then timed with block_until_ready.
+
+usage: bank_jax.py [--members M] [--T T] [--dt DT] [--rate T_SHORT] [--repetitions R]
+Prints one JSON object: wall seconds of the step loop at T (and at T_SHORT), member-steps/s per repetition (from
+the difference when --rate is given: perf/compare_bank_numpy.sh's method), the median, and the device.
+"""
+import argparse
+import json
+import statistics
+import time
+
+import jax
+
+jax.config.update("jax_enable_x64", True)
+import jax.numpy as jnp  # noqa: E402
+
+Q, R = 1.0, 0.5
+
+
+def make_run(members, steps, dt):
+    sq, V, W = dt**0.5, R * R, Q * Q * dt
+
+    def update_predict(m, P, dy, kind):
+        K = P / (V + P * dt)
+        m = m + K * (dy - m * dt)
+        P = P - K * P * dt
+        if kind == "KBL":
+            return m * (1.0 - dt), P * (1.0 - dt) ** 2 + W
+        s, c = jnp.sin(m), jnp.cos(m)
+        if kind == "EKF":
+            a, J = -s, -c
+        elif kind == "SOF":
+            a, J = -s + 0.5 * s * P, -c
+        else:  # QLF
+            damping = jnp.exp(-0.5 * P)
+            a, J = -s * damping, -c * damping
+        return m + a * dt, (1.0 + J * dt) ** 2 * P + W
+
+    def step(carry, _):
+        key, x, ms, Ps = carry
+        key, k1, k2 = jax.random.split(key, 3)
+        dw = jax.random.normal(k1, (members,), dtype=jnp.float64)
+        dv = jax.random.normal(k2, (members,), dtype=jnp.float64)
+        dy = x * dt + R * sq * dv
+        x = x - jnp.sin(x) * dt + Q * sq * dw
+        out = [update_predict(m, P, dy, kind) for m, P, kind in zip(ms, Ps, ("EKF", "SOF", "QLF", "KBL"))]
+        return (key, x, tuple(o[0] for o in out), tuple(o[1] for o in out)), None
+
+    @jax.jit
+    def run(key):
+        key, k0 = jax.random.split(key)
+        x = 1.0 + jax.random.normal(k0, (members,), dtype=jnp.float64)
+        ones = jnp.ones(members, dtype=jnp.float64)
+        carry = (key, x, (ones,) * 4, (ones,) * 4)
+        carry, _ = jax.lax.scan(step, carry, None, length=steps)
+        return carry[1], carry[2], carry[3]
+
+    return run
+
+
+def timed(run, seed):
+    out = run(jax.random.PRNGKey(seed))  # compile
+    jax.block_until_ready(out)
+    start = time.perf_counter()
+    out = run(jax.random.PRNGKey(seed + 1))
+    jax.block_until_ready(out)
+    return time.perf_counter() - start
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--members", type=int, default=1000000)
+    ap.add_argument("--T", type=float, default=0.25)
+    ap.add_argument("--dt", type=float, default=1e-3)
+    ap.add_argument("--rate", type=float, default=None)
+    ap.add_argument("--repetitions", type=int, default=3)
+    a = ap.parse_args()
+    steps = round(a.T / a.dt)
+    run_long = make_run(a.members, steps, a.dt)
+    run_short = make_run(a.members, round(a.rate / a.dt), a.dt) if a.rate else None
+    long_s, short_s, rates = [], [], []
+    for rep in range(a.repetitions):
+        long_s.append(timed(run_long, 2 * rep))
+        if run_short:
+            short_s.append(timed(run_short, 2 * rep))
+            rates.append(a.members * (steps - round(a.rate / a.dt)) / (long_s[-1] - short_s[-1]))
+        else:
+            rates.append(a.members * steps / long_s[-1])
+    print(json.dumps({"jax": jax.__version__, "device": str(jax.devices()[0]), "members": a.members, "T": a.T,
+                      "dt": a.dt, "step_loop_s": long_s, "step_loop_short_s": short_s,
+                      "member_steps_per_s": rates, "median": statistics.median(rates)}))
+
+
+if __name__ == "__main__":
+    main()
