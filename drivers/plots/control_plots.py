@@ -17,7 +17,7 @@ import math
 import os
 import sys
 
-from compare_plots import COLORS, NO_FIGURES, fmt, model_name, read_csv, save  # the shared helpers
+from compare_plots import COLORS, NO_FIGURES, fmt, model_name, read_csv, save, timing_line  # the shared helpers
 
 import compare_plots
 
@@ -88,18 +88,6 @@ def plot_ranking(plt, directory, summary, colors):
     ax.set_yticklabels([name for name, _ in items])
     ax.set_xlabel("expected cost J (±2 SE)")
     save(fig, directory, "ranking")
-
-
-def timing_line(summary):
-    """The report's line on speed, from summary.json's "timing" (None without it)."""
-    t = summary.get("timing")
-    if not t:
-        return None
-    rates = f"{t['member_steps_per_s']:.3g} member-steps/s"
-    if "particle_steps_per_s" in t:
-        rates += f", {t['particle_steps_per_s']:.3g} particle-steps/s"
-    return (f"- wall time: step loop {t['step_loop_s']:.3g} s ({rates}); whole command {t['command_s']:.3g} s "
-            "up to the results (figures not included)")
 
 
 def write_report(directory, summary, figures, no_figures=None):
