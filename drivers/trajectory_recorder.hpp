@@ -14,12 +14,14 @@
 #include "engine/filter_bank.hpp"
 #include "engine/member_share.hpp"
 #include "engine/reference_estimator.hpp"
+#include "kernels/element_gather.hpp"
 #include "kernels/host_copy.hpp"
 
 #include <Kokkos_Core.hpp>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -74,9 +76,15 @@ class TrajectoryRecorder {
       if (snapshot) pf = e;
     }
     const bool density = pf && next_density_ < density_times_.size() && t >= density_times_[next_density_] - 1e-9;
+    std::vector<std::uintptr_t> addresses;  // first pass: what the rows read; then one gather; then the rows
+    ElementReader record{&addresses};
+    for (long member : members_)
+      if (share_.holds(member)) trajectory_rows(t, member, member - share_.first, bank, outside, pf, snapshot, record);
+    ElementReader read{nullptr, &gather_(ExecSpace(), addresses)};
     for (long member : members_) {
       std::string rows;
-      if (share_.holds(member)) rows = trajectory_rows(t, member, member - share_.first, bank, outside, pf, snapshot);
+      if (share_.holds(member))
+        rows = trajectory_rows(t, member, member - share_.first, bank, outside, pf, snapshot, read);
       trajectories_ += collective::broadcast(rows, member_owner(member, share_.total));
     }
     if (density) {
@@ -140,28 +148,44 @@ class TrajectoryRecorder {
     return host_copy(Kokkos::subview(v, member, Kokkos::ALL));
   }
 
+  /// How trajectory_rows reads element (row `local`, column) of a bank view: a first pass records where
+  /// (`record`), ElementGather copies all of them at once, and a second pass reads the values in the same order.
+  struct ElementReader {
+    std::vector<std::uintptr_t>* record = nullptr;
+    const std::vector<double>* values = nullptr;
+    std::size_t next = 0;
+    template <class View>
+    double operator()(const View& v, long local, int column) {
+      if (record == nullptr) return (*values)[next++];
+      record->push_back(element_address(v, local, column));
+      return 0.0;
+    }
+  };
+
   /// Global member `member`, row `local` of this rank's bank, at time t.
   template <class TruthModel>
   static std::string trajectory_rows(double t, long member, long local,
                                      const FilterBank<ExecSpace, Model, TruthModel>& bank,
                                      const std::vector<const ReferenceEstimator<MemSpace>*>& outside,
                                      const ReferenceEstimator<MemSpace>* pf,
-                                     const std::optional<ParticleSnapshot>& snapshot) {
+                                     const std::optional<ParticleSnapshot>& snapshot, ElementReader& read) {
     std::string rows;
-    const auto x = row(bank.truths().state(), local);
-    for (int i = 0; i < n; ++i) add_trajectory(rows, member, t, i, "truth", x(i), x(i), x(i));
+    for (int i = 0; i < n; ++i) {
+      const double x = read(bank.truths().state(), local, i);
+      add_trajectory(rows, member, t, i, "truth", x, x, x);
+    }
     for (const auto& name : bank.filter_names())
-      bank.with_slot(
-          name, [&](const auto& slot) { add_gaussian(rows, member, t, name, row(slot.m, local), row(slot.P, local)); });
+      bank.with_slot(name, [&](const auto& slot) { add_gaussian(rows, member, t, name, local, slot.m, slot.P, read); });
     for (const auto* e : outside) {
       if (e == pf) {
-        const auto mean = row(pf->mean(), local);
         for (int i = 0; i < n; ++i) {
+          const double mean = read(pf->mean(), local, i);
+          if (read.record != nullptr) continue;
           const std::vector<double> band = snapshot->quantiles(static_cast<int>(local), i, {0.05, 0.95});
-          add_trajectory(rows, member, t, i, pf->name(), mean(i), band[0], band[1]);
+          add_trajectory(rows, member, t, i, pf->name(), mean, band[0], band[1]);
         }
       } else {
-        add_gaussian(rows, member, t, e->name(), row(e->mean(), local), row(e->covariance(), local));
+        add_gaussian(rows, member, t, e->name(), local, e->mean(), e->covariance(), read);
       }
     }
     return rows;
@@ -173,12 +197,14 @@ class TrajectoryRecorder {
             format_number(estimate) + "," + format_number(lower) + "," + format_number(upper) + "\n";
   }
 
-  template <class MeanRow, class CovarianceRow>
-  static void add_gaussian(std::string& rows, long member, double t, const std::string& name, const MeanRow& m,
-                           const CovarianceRow& P) {
+  /// The estimate of row `local` of (m, packed P) with its +-2 sigma band.
+  template <class MeanView, class CovarianceView>
+  static void add_gaussian(std::string& rows, long member, double t, const std::string& name, long local,
+                           const MeanView& m, const CovarianceView& P, ElementReader& read) {
     for (int i = 0; i < n; ++i) {
-      const double sd = std::sqrt(std::max(0.0, P(packed_index(n, i, i))));
-      add_trajectory(rows, member, t, i, name, m(i), m(i) - 2.0 * sd, m(i) + 2.0 * sd);
+      const double mean = read(m, local, i);
+      const double sd = std::sqrt(std::max(0.0, read(P, local, packed_index(n, i, i))));
+      add_trajectory(rows, member, t, i, name, mean, mean - 2.0 * sd, mean + 2.0 * sd);
     }
   }
 
@@ -222,6 +248,7 @@ class TrajectoryRecorder {
   std::size_t next_density_ = 0;
   BimodalSnapshot bimodal_;
   std::string trajectories_, density_, bimodal_rows_;
+  ElementGather<ExecSpace> gather_;
 };
 
 }  // namespace kushner

@@ -251,30 +251,14 @@ class FilterBank {
   }
 
   /// Metrics of filter `name` at the latest output time.
-  FilterSnapshot snapshot(const std::string& name) const {
-    FilterSnapshot s;
-    with_slot(name, [&](const auto& slot) {
-      const Estimate rmse = root_mean(slot.snapshot, snapshot_squared_error);
-      const Estimate nees = mean(slot.snapshot, snapshot_nees);
-      s.rmse_truth = rmse.value;
-      s.rmse_truth_se = rmse.standard_error;
-      s.nees = nees.value;
-      s.nees_se = nees.standard_error;
-      const Estimate ref = scored_against_reference(name) ? root_mean(slot.snapshot, snapshot_reference_squared_error)
-                                                          : Estimate{std::nan(""), std::nan(""), 0};
-      s.rmse_ref = ref.value;
-      s.rmse_ref_se = ref.standard_error;
-      s.diverged = count_status(space_, slot.status, Status::not_positive_definite, truth_status_) +
-                   count_status(space_, slot.status, Status::non_finite, truth_status_);
-    });
-    return s;
-  }
+  FilterSnapshot snapshot(const std::string& name) const { return snapshots({name}).front(); }
 
-  /// snapshot() of every filter of `names`, the same numbers, with the moments of all their snapshot columns
-  /// taken in one pass (column_moments) instead of one pass per column.
+  /// snapshot() of every filter of `names`: the moments of all their snapshot columns in one pass (ColumnMoments)
+  /// and their divergence counts in another (DivergedCounts), whatever the number of filters: on a GPU each pass
+  /// waits for the device once.
   std::vector<FilterSnapshot> snapshots(const std::vector<std::string>& names) const {
-    using Column = Kokkos::View<const double*, MemSpace>;
-    std::vector<Column> columns;
+    std::vector<typename ColumnMoments<ExecSpace>::Column> columns;
+    std::vector<BankScalar<Status, MemSpace>> statuses;
     std::vector<int> first;  // names[i]'s columns start at first[i]: squared error, NEES[, reference]
     for (const auto& name : names)
       with_slot(name, [&](const auto& slot) {
@@ -283,8 +267,10 @@ class FilterBank {
         columns.push_back(Kokkos::subview(slot.snapshot, Kokkos::ALL, int(snapshot_nees)));
         if (scored_against_reference(name))
           columns.push_back(Kokkos::subview(slot.snapshot, Kokkos::ALL, int(snapshot_reference_squared_error)));
+        statuses.push_back(slot.status);
       });
-    const std::vector<EnsembleMoments> moments = kushner::column_moments(space_, columns);
+    const std::vector<EnsembleMoments> moments = snapshot_moments_(space_, columns);
+    const std::vector<long> diverged = diverged_counts_(space_, statuses, truth_status_);
     std::vector<FilterSnapshot> result;
     for (std::size_t i = 0; i < names.size(); ++i) {
       FilterSnapshot s;
@@ -298,10 +284,7 @@ class FilterBank {
       s.nees_se = nees.standard_error;
       s.rmse_ref = ref.value;
       s.rmse_ref_se = ref.standard_error;
-      with_slot(names[i], [&](const auto& slot) {
-        s.diverged = count_status(space_, slot.status, Status::not_positive_definite, truth_status_) +
-                     count_status(space_, slot.status, Status::non_finite, truth_status_);
-      });
+      s.diverged = diverged[i];
       result.push_back(s);
     }
     return result;
@@ -436,6 +419,8 @@ class FilterBank {
   typename K::Slots slots_;
   ReferenceEstimator<MemSpace>* reference_ = nullptr;
   std::vector<Estimator> estimators_;
+  mutable ColumnMoments<ExecSpace> snapshot_moments_;  // buffers kept from one output step to the next
+  mutable DivergedCounts<ExecSpace> diverged_counts_;
 };
 
 }  // namespace kushner

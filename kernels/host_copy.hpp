@@ -6,6 +6,20 @@
 
 namespace kushner {
 
+/// Host memory that receives a device's results again and again (an output step's reductions): page-locked for a
+/// GPU, where a copy into pageable memory passes through a staging buffer at a fraction of the bus's speed; the
+/// host's own memory otherwise.
+template <class MemSpace>
+struct HostStaging {
+  using space = Kokkos::HostSpace;
+};
+#if defined(KOKKOS_ENABLE_CUDA)
+template <>
+struct HostStaging<Kokkos::CudaSpace> {
+  using space = Kokkos::CudaHostPinnedSpace;
+};
+#endif
+
 template <class View>
 auto host_copy(const View& v) {
   using MemSpace = typename View::memory_space;

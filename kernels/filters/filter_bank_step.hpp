@@ -87,7 +87,7 @@ struct FilterBankStep {
                     const Mat<Model::obs_dim, Model::obs_dim>& V) const {
     constexpr int n = Model::state_dim, p = Model::obs_dim;
     if (!slot.enabled) return;
-    if constexpr (filter_step_is_pure<Filter, n>()) {
+    if constexpr (filter_step_is_pure<Filter, n>) {
       const auto lanes = [&](const auto& filter) {
         if (record)
           filter_lanes<true>(slot, filter, begin, end, live, V);

@@ -125,11 +125,10 @@ struct has_fixed_method<Filter, std::void_t<decltype(std::declval<const Filter&>
 
 /// Whether advance_lane may run Filter: its step changes nothing but the m and P it is given (no state of its
 /// own, no random numbers, no known input), so a step computed for a member and discarded is no step.
+/// (A variable, not a function: nvcc will not call a host constexpr function from device code.)
 template <class Filter, int N>
-constexpr bool filter_step_is_pure() {
-  return !detail::is_randomized<Filter>::value && !detail::has_prepass<Filter>::value &&
-         !detail::has_known_input<Filter, N>::value;
-}
+constexpr bool filter_step_is_pure = !detail::is_randomized<Filter>::value && !detail::has_prepass<Filter>::value &&
+                                     !detail::has_known_input<Filter, N>::value;
 
 /// advance() of one member as one lane of a host loop over members in SIMD lanes (FilterBankStep::run_chunk): the
 /// step, the checks and the scores are computed whatever the member's state, and what advance() would store is
@@ -153,7 +152,7 @@ KOKKOS_INLINE_FUNCTION std::int64_t advance_lane(const Filter& filter, const Mod
                                                  const Mat<Model::obs_dim, Model::obs_dim>& V, const double* x,
                                                  std::size_t x_stride, const double* dy, std::size_t dy_stride) {
   constexpr int n = Model::state_dim, p = Model::obs_dim;
-  static_assert(!Model::discrete_time && filter_step_is_pure<Filter, n>(), "advance_lane: see filter_step_is_pure");
+  static_assert(!Model::discrete_time && filter_step_is_pure<Filter, n>, "advance_lane: see filter_step_is_pure");
   const bool stepped = live && old_status == static_cast<std::int64_t>(Status::ok);
   Vec<n> m, xm;
   Mat<n, n> P;
