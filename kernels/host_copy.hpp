@@ -1,7 +1,8 @@
 #pragma once
 // A host copy of any view, strided subviews included. Kokkos cannot deep_copy a non-contiguous device view
 // straight to the host (no execution space reaches both), so on a device the strided view is first packed
-// into a dense one in its own memory space, then copied over. On the host the view is returned as it is.
+// into a dense one in its own memory space, then copied over. On the host the view is returned as it is. Also
+// where the host receives copies made again and again (HostStaging).
 #include <Kokkos_Core.hpp>
 
 namespace kushner {
