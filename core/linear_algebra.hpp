@@ -103,6 +103,17 @@ KOKKOS_INLINE_FUNCTION double cholesky_quadratic_form(const Mat<N, N>& L, const 
   return s;
 }
 
+/// log N(r; 0, R R^T), the Gaussian log density of a noise R d with d standard normal (R R^T positive definite;
+/// -inf when it is not).
+template <int N>
+KOKKOS_INLINE_FUNCTION double gaussian_log_density(const Mat<N, N>& R, const Vec<N>& r) {
+  Mat<N, N> L;
+  if (!cholesky(R * transpose(R), L)) return -math::infinity();
+  double log_det = 0.0;
+  for (int i = 0; i < N; ++i) log_det += 2.0 * math::log(L(i, i));
+  return -0.5 * (cholesky_quadratic_form(L, r) + log_det + N * math::log(2.0 * math::pi));
+}
+
 template <int N>
 KOKKOS_INLINE_FUNCTION bool all_finite(const Vec<N>& x) {
   for (int i = 0; i < N; ++i)

@@ -25,8 +25,9 @@ int run_models(bool json) {
       std::cout << "    --set " << p["name"].get<std::string>() << "=" << p["default"].dump() << "  "
                 << p["description"].get<std::string>() << "\n";
   }
-  std::cout << "--model-file FILE instead of --model: a polynomial model of your own (state_dim 1..3, drift of degree "
-               "<= 4, linear observation) from a TOML file; README, \"Models\"; examples in models/examples/\n";
+  std::cout << "--model-file FILE instead of --model: a polynomial model of your own (state_dim 1..3, drift or "
+               "discrete-time transition of degree <= 4, observation of degree <= 3) from a TOML file; README, "
+               "\"Models\"; examples in models/examples/\n";
   return 0;
 }
 

@@ -138,10 +138,10 @@ std::map<std::vector<int>, int> monomial_indices(int n) {
 }
 
 /// One polynomial of the file, g_k(x) = c0_k + sum_i c1_ki x_i + sum of monomials of degree 2..max_degree, for
-/// k < rows: the drift (rows = n, a0..a4, [[drift.terms]]) or the observation (rows = p, c0..c3 or C for c1,
-/// [[observation.terms]]). Tensors and terms are summed into one coefficient per monomial.
+/// k < rows: the drift or transition (rows = n, a0..a4, [[drift.terms]]) or the observation (rows = p, c0..c3 or
+/// C for c1, [[observation.terms]]). Tensors and terms are summed into one coefficient per monomial.
 struct PolynomialPart {
-  std::string prefix;  // "drift." or "observation."
+  std::string prefix;  // "drift.", "transition." or "observation."
   char letter;         // 'a' or 'c': the tensors' names
   int max_degree;
   int rows;  // -1: the first tensor found sets it (the observation's p)
@@ -231,10 +231,26 @@ void read_polynomial(const ModelFileReader& in, const toml::table* table, int n,
 
 PolynomialModelSpec read_spec(const toml::table& root, const std::string& path) {
   const ModelFileReader in(path);
-  in.only_known_keys(root, "",
-                     {"state_dim", "name", "description", "drift", "diffusion", "observation", "control", "initial"});
   PolynomialModelSpec spec;
   spec.path = path;
+  if (const toml::node* time = root.get("time")) {
+    const auto* text = time->as_string();
+    if (text == nullptr || (text->get() != "continuous" && text->get() != "discrete"))
+      in.fail("time", "expected \"continuous\" or \"discrete\"");
+    spec.discrete = text->get() == "discrete";
+  }
+  // The tables of the two times: dx = f dt + b dw, or x[k+1] = F(x) + G e.
+  const std::string f_table = spec.discrete ? "transition" : "drift";
+  const std::string noise_table = spec.discrete ? "process_noise" : "diffusion", noise_key = spec.discrete ? "G" : "b";
+  for (const char* other : {"drift", "diffusion", "transition", "process_noise"})
+    if (other != f_table && other != noise_table && root.get(other) != nullptr)
+      in.fail(other, spec.discrete ? "a discrete-time model (time = \"discrete\") has [transition] and "
+                                     "[process_noise], not [drift] and [diffusion]"
+                                   : "a continuous-time model has [drift] and [diffusion]; [transition] and "
+                                     "[process_noise] are a discrete one's (time = \"discrete\")");
+  in.only_known_keys(
+      root, "",
+      {"state_dim", "time", "name", "description", f_table, noise_table, "observation", "control", "initial"});
 
   const toml::node* dim = root.get("state_dim");
   if (dim == nullptr) in.fail("state_dim", "missing (required: the state dimension, 1, 2 or 3)");
@@ -248,24 +264,25 @@ PolynomialModelSpec read_spec(const toml::table& root, const std::string& path) 
     (std::string(key) == "name" ? spec.label : spec.description) = node->as_string()->get();
   }
 
-  // Drift: the tensors contracted with x, summed into one coefficient per monomial.
-  const toml::table* drift = in.table(root, "drift", false);
-  if (drift) in.only_known_keys(*drift, "drift.", {"a0", "a1", "a2", "a3", "a4", "terms"});
-  PolynomialPart f{"drift.", 'a', 4, spec.n, {}, {}, {}};
+  // Drift (or transition): the tensors contracted with x, summed into one coefficient per monomial.
+  const toml::table* drift = in.table(root, f_table, false);
+  if (drift) in.only_known_keys(*drift, f_table + ".", {"a0", "a1", "a2", "a3", "a4", "terms"});
+  PolynomialPart f{f_table + ".", 'a', 4, spec.n, {}, {}, {}};
   read_polynomial(in, drift, spec.n, f);
   spec.a0 = std::move(f.constant);
   spec.a1 = std::move(f.linear);
   spec.monomial = std::move(f.monomial);
 
-  // Diffusion b (n x q).
-  const toml::table* diffusion = in.table(root, "diffusion", true);
-  in.only_known_keys(*diffusion, "diffusion.", {"b"});
+  // Diffusion b (or the process noise's G), n x q.
+  const toml::table* noise = in.table(root, noise_table, true);
+  const std::string noise_name = noise_table + "." + noise_key;
+  in.only_known_keys(*noise, noise_table + ".", {noise_key});
   std::vector<int> b_dims = {spec.n, -1};
-  in.array(diffusion, "diffusion.", "b", true, b_dims, spec.b);
+  in.array(noise, noise_table + ".", noise_key, true, b_dims, spec.b);
   spec.q = b_dims[1];
   if (spec.q > spec.n)
-    in.fail("diffusion.b", "has " + std::to_string(spec.q) + " columns, at most state_dim = " + std::to_string(spec.n) +
-                               " (give an n x n matrix with the same b b^T)");
+    in.fail(noise_name, "has " + std::to_string(spec.q) + " columns, at most state_dim = " + std::to_string(spec.n) +
+                            " (give an n x n matrix with the same " + noise_key + " " + noise_key + "^T)");
 
   // Observation: h of degree <= 3, like the drift; p rows (the first tensor given sets p).
   const toml::table* observation = in.table(root, "observation", true);

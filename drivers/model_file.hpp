@@ -1,7 +1,9 @@
 #pragma once
-// `--model-file FILE`: the polynomial model (models/polynomial_model.hpp) a model file describes
-// (models/polynomial_spec.hpp: the format), its record in summary.json, and the dispatch on its dimension.
+// `--model-file FILE`: the polynomial model (models/polynomial_model.hpp, models/discrete_polynomial_model.hpp) a
+// model file describes (models/polynomial_spec.hpp: the format), its record in summary.json, and the dispatch on
+// its time and dimension.
 #include "core/errors.hpp"
+#include "models/discrete_polynomial_model.hpp"
 #include "models/model_checks.hpp"
 #include "models/parameters.hpp"
 #include "models/polynomial_model.hpp"
@@ -26,12 +28,14 @@ void check_file_covariance(const PolynomialModelSpec& spec, const std::string& k
   }
 }
 
-/// The model of a checked file; InputError "path: key: ..." unless R R^T is positive definite and x0_cov,
-/// prior_cov are covariances.
-template <int N>
-PolynomialModel<N> make_polynomial_model(const PolynomialModelSpec& spec, const PolynomialModelSource* source) {
+/// The model of a checked file (Model: PolynomialModel<N>, or DiscretePolynomialModel<N> for time = "discrete",
+/// whose F and G fill the drift's and the diffusion's fields); InputError "path: key: ..." unless R R^T is positive
+/// definite and x0_cov, prior_cov are covariances.
+template <int N, class Model = PolynomialModel<N>>
+Model make_polynomial_model(const PolynomialModelSpec& spec, const PolynomialModelSource* source) {
   KUSHNER_REQUIRE(spec.n == N, "model file has state_dim " << spec.n << ", not " << N);
-  PolynomialModel<N> model;
+  KUSHNER_REQUIRE(spec.discrete == Model::discrete_time, "model file's time is not the model type's");
+  Model model;
   model.source = source;
   model.obs_rows = spec.p;
   model.noise_columns = spec.q;
@@ -66,11 +70,12 @@ PolynomialModel<N> make_polynomial_model(const PolynomialModelSpec& spec, const 
   return model;
 }
 
-/// What summary.json records of a polynomial model: its file, and the coefficients as they run (drift as
-/// a0, a1 and the nonzero terms of degree 2..4 in the file's [[drift.terms]] form; b, C, R in the file's
-/// shapes).
-template <int N>
-nlohmann::json polynomial_model_json(const PolynomialModel<N>& model) {
+/// What summary.json records of a polynomial model: its file, and the coefficients as they run (drift, or a
+/// discrete model's transition, as a0, a1 and the nonzero terms of degree 2..4 in the file's [[drift.terms]]
+/// form; b (G), C, R in the file's shapes).
+template <class Model>
+nlohmann::json polynomial_model_json(const Model& model) {
+  constexpr int N = Model::state_dim;
   const int p = model.obs_rows, q = model.noise_columns;
   auto matrix = [](const auto& m, int rows, int cols) {
     std::vector<std::vector<double>> r(rows, std::vector<double>(cols));
@@ -93,14 +98,16 @@ nlohmann::json polynomial_model_json(const PolynomialModel<N>& model) {
     return list;
   };
   nlohmann::json j = {{"state_dim", N},
+                      {"time", Model::discrete_time ? "discrete" : "continuous"},
                       {"obs_dim", p},
                       {"noise_dim", q},
-                      {"drift",
+                      {Model::discrete_time ? "transition" : "drift",
                        {{"a0", std::vector<double>(model.a0.v, model.a0.v + N)},
                         {"a1", matrix(model.a1, N, N)},
                         {"terms", terms(model.coefficient, N)},
                         {"degree", model.model_facts().drift_degree}}},
-                      {"diffusion", {{"b", matrix(model.b, N, q)}}},
+                      {Model::discrete_time ? "process_noise" : "diffusion",
+                       {{Model::discrete_time ? "G" : "b", matrix(model.b, N, q)}}},
                       {"observation",
                        {{"c0", std::vector<double>(model.c0.v, model.c0.v + p)},
                         {"C", matrix(model.C, p, N)},
@@ -118,7 +125,8 @@ nlohmann::json polynomial_model_json(const PolynomialModel<N>& model) {
 
 /// Reads the model file `path`, applies `sets` ("key=value": the initial law, x0_mean, x0_cov, prior_mean,
 /// prior_cov; the rest is edited in the file), validates the model and calls f(model) with a
-/// PolynomialModel<state_dim>. InputError for a bad file or assignment.
+/// PolynomialModel<state_dim> (DiscretePolynomialModel<state_dim> for time = "discrete"). InputError for a bad
+/// file or assignment.
 template <class F>
 void with_model_file(const std::string& path, const std::vector<std::string>& sets, F&& f) {
   const PolynomialModelSpec spec = read_polynomial_model_file(path);
@@ -132,7 +140,7 @@ void with_model_file(const std::string& path, const std::vector<std::string>& se
   }
   auto run = [&](auto* tag) {
     using Model = std::remove_pointer_t<decltype(tag)>;
-    Model model = make_polynomial_model<Model::state_dim>(spec, &source);
+    Model model = make_polynomial_model<Model::state_dim, Model>(spec, &source);
     ParameterRecorder settable;
     model.parameters(settable);
     std::string names;
@@ -147,10 +155,13 @@ void with_model_file(const std::string& path, const std::vector<std::string>& se
     validate_model(model);
     f(model);
   };
-  switch (spec.n) {
+  switch (spec.n * (spec.discrete ? -1 : 1)) {
     case 1: run(static_cast<PolynomialModel<1>*>(nullptr)); break;
     case 2: run(static_cast<PolynomialModel<2>*>(nullptr)); break;
     case 3: run(static_cast<PolynomialModel<3>*>(nullptr)); break;
+    case -1: run(static_cast<DiscretePolynomialModel<1>*>(nullptr)); break;
+    case -2: run(static_cast<DiscretePolynomialModel<2>*>(nullptr)); break;
+    case -3: run(static_cast<DiscretePolynomialModel<3>*>(nullptr)); break;
     default: KUSHNER_REQUIRE(false, "read_polynomial_model_file let state_dim " << spec.n << " through");
   }
 }

@@ -15,16 +15,20 @@ namespace kushner {
 template <class Model>
 constexpr bool has_exact_reference = !std::is_void_v<exact_reference_t<Kokkos::DefaultHostExecutionSpace, Model>>;
 
-/// Why the exact filter cannot run `model`, or nullptr: no exact or grid filter for its type, or (a model known
-/// only at run time) noise the grid filter cannot take.
+/// Why the exact filter cannot run `model`, or nullptr: no exact or grid filter for its type, or noise (or, in
+/// discrete time, a prior) its grid filter cannot take.
 template <class Model>
 const char* exact_filter_unsupported(const Model& model) {
-  if (!has_exact_reference<Model>)
-    return Model::discrete_time ? "no grid filter for this discrete-time model (scalar, bounded noises only)"
-                                : "no exact filter, and no grid filter above dimension 2";
-  if constexpr (ModelTraits<Model>::runtime_checked)
-    if (!model.model_facts().axis_aligned_noise) return "the grid filter needs axis-aligned noise (b b^T diagonal)";
-  return nullptr;
+  if constexpr (!has_exact_reference<Model>) {
+    return "no exact filter, and no grid filter above dimension 2";
+  } else if constexpr (std::is_same_v<exact_reference_t<Kokkos::DefaultHostExecutionSpace, Model>,
+                                      DiscreteGaussianGridFilter<Kokkos::DefaultHostExecutionSpace, Model>>) {
+    return DiscreteGaussianGridFilter<Kokkos::DefaultHostExecutionSpace, Model>::unsupported(model);
+  } else {
+    if constexpr (ModelTraits<Model>::runtime_checked)
+      if (!model.model_facts().axis_aligned_noise) return "the grid filter needs axis-aligned noise (b b^T diagonal)";
+    return nullptr;
+  }
 }
 
 template <class ExecSpace, class Model>
@@ -58,6 +62,11 @@ class ExactReferenceEstimator final : public ReferenceEstimator<typename ExecSpa
       return {{"kind", std::string("grid")},
               {"note", std::string("point-mass Bayes filter with exact cell masses (noise CDFs)")},
               {"cells", static_cast<long>(reference_.cells())}};
+    else if constexpr (std::is_same_v<Reference, DiscreteGaussianGridFilter<ExecSpace, Model>>)
+      return {{"kind", std::string("grid")},
+              {"note", std::string("point-mass Bayes filter: trapezoidal rule on a grid that follows the posterior "
+                                   "(Gaussian noises)")},
+              {"points", static_cast<long>(reference_.cells())}};
     else
       return fields("kalman", "Kalman filter of the Euler-Maruyama discretization (exact for it)");
   }

@@ -56,14 +56,7 @@ struct LinearDiscreteModel : InitialLaw<2> {
   KOKKOS_INLINE_FUNCTION Mat<N, N> observation_jacobian(double, const Vec<N>&) const { return H; }
   KOKKOS_INLINE_FUNCTION Mat<N, N> observation_noise(double) const { return R; }
   KOKKOS_INLINE_FUNCTION Vec<N> observation_noise_sample(const Vec<N>& normals, double) const { return R * normals; }
-  /// log N(r; 0, R R^T).
-  KOKKOS_INLINE_FUNCTION double observation_log_density(const Vec<N>& r) const {
-    Mat<N, N> L;
-    cholesky(R * transpose(R), L);
-    double log_det = 0.0;
-    for (int i = 0; i < N; ++i) log_det += 2.0 * math::log(L(i, i));
-    return -0.5 * (cholesky_quadratic_form(L, r) + log_det + N * math::log(2.0 * math::pi));
-  }
+  KOKKOS_INLINE_FUNCTION double observation_log_density(const Vec<N>& r) const { return gaussian_log_density(R, r); }
   KOKKOS_INLINE_FUNCTION double observation_max_log_density() const { return observation_log_density(Vec<N>::zero()); }
 };
 

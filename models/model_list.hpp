@@ -10,6 +10,7 @@
 #include "models/clark_quintic_model.hpp"
 #include "models/cubic_oscillator_model.hpp"
 #include "models/cubic_sensor_model.hpp"
+#include "models/discrete_polynomial_model.hpp"
 #include "models/linear_discrete_model.hpp"
 #include "models/linear_model.hpp"
 #include "models/ou_model.hpp"
@@ -44,11 +45,14 @@
   DISCRETE_MODEL(ClarkQuinticModel)             \
   DISCRETE_MODEL(LinearDiscreteModel)
 
-/// The polynomial models of `--model-file`, one type per state dimension.
-#define KUSHNER_FILE_MODELS(FILE_MODEL) \
-  FILE_MODEL(PolynomialModel<1>)        \
-  FILE_MODEL(PolynomialModel<2>)        \
-  FILE_MODEL(PolynomialModel<3>)
+/// The polynomial models of `--model-file`, one type per time and state dimension.
+#define KUSHNER_FILE_MODELS(FILE_MODEL)  \
+  FILE_MODEL(PolynomialModel<1>)         \
+  FILE_MODEL(PolynomialModel<2>)         \
+  FILE_MODEL(PolynomialModel<3>)         \
+  FILE_MODEL(DiscretePolynomialModel<1>) \
+  FILE_MODEL(DiscretePolynomialModel<2>) \
+  FILE_MODEL(DiscretePolynomialModel<3>)
 
 namespace kushner {
 

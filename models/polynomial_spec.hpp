@@ -3,6 +3,10 @@
 // read from TOML by models/model_file.cpp (toml++). Plain C++ without Kokkos: in CUDA builds that parser is
 // compiled by the host compiler alone (toml++ does not get through nvcc). The format, with n = state_dim (1..3):
 //   state_dim = 2                    # required
+//   time = "continuous"              # optional; "discrete": x[k+1] = F(x) + B u + G e, z = h(x) + R d
+//                                    # (models/discrete_polynomial_model.hpp), with [transition] (F, the keys of
+//                                    # [drift]) and [process_noise] G = [[...]] (n x q) in place of [drift],
+//                                    [diffusion]
 //   name = "..."                     # optional, for reports; description = "..." likewise
 //   [drift]                          # f_k = a0[k] + sum_i a1[k][i] x_i + sum_ij a2[k][i][j] x_i x_j + ... + a4
 //   a0 = [...]                       # n            all optional (absent: zero)
@@ -39,6 +43,7 @@ namespace kushner {
 /// the degree-4 entries zero); `B` the control input's column (empty: no [control]).
 struct PolynomialModelSpec {
   std::string path, label, description;
+  bool discrete = false;  // time = "discrete": `a0`.. hold F, `b` holds G
   int n = 0, p = 0, q = 0;
   std::vector<double> a0, a1, monomial, b, c0, C, observation_monomial, R, B, x0_mean, x0_cov, prior_mean, prior_cov;
 };

@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
-# Issue 15's GPU figures in one device call (phases: build, run):
-#   build  build-cuda-discrete/: CUDA + OpenMP + Serial, kushner and the discrete-time tests
-#   run    test_discrete_filters on the GPU (its default space); `kushner filter` on clark-linear and
-#          linear-discrete, every discrete filter, PF and EXACT, CUDA against Serial (largest relative difference
-#          per file, and per filter), and clark-quintic (KF-NOM, MOM-NOM along the nominal path); `kushner control` on
-#          clark-linear (with MOM-SPEC) and clark-quintic (the perturbation loop LQR-NOM), CUDA against Serial; `reproduce
-#          clark-table-2.1` at 20000 members on the GPU, timed
+# Issue 15's GPU figures in one device call (phases: build, tests, filters, control, reproduce; `run` = the last four):
+#   build      build-cuda-discrete/: CUDA + OpenMP + Serial, kushner and the discrete-time tests
+#   tests      test_discrete_filters on the GPU (its default space), test_discrete_control
+#   filters    `kushner filter` on clark-linear, linear-discrete and the discrete model file duffing_discrete.toml,
+#              every discrete filter, PF and EXACT, CUDA against Serial (largest relative difference per file, and
+#              per filter), and clark-quintic (KF-NOM, MOM-NOM along the nominal path)
+#   control    `kushner control` on clark-linear (with MOM-SPEC) and clark-quintic (the perturbation loop LQR-NOM),
+#              CUDA against Serial
+#   reproduce  `reproduce clark-table-2.1` at 20000 members and clark-table-3.1 on the GPU, timed
 #   OUT=<dir> KUSHNER_PHASES="build run" perf/run_discrete_gpu.sh
 set -uo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
@@ -13,6 +15,7 @@ out=${OUT:-$here/discrete-gpu-out}
 mkdir -p "$out"
 build=$here/build-cuda-discrete
 phases=" ${KUSHNER_PHASES:-build run} "
+phases=${phases/ run / tests filters control reproduce }
 want() { [[ "$phases" == *" $1 "* ]]; }
 export PATH=/usr/local/cuda/bin:$PATH OMP_PROC_BIND=false
 status=0
@@ -36,15 +39,20 @@ if want build; then
   log "built (status $status)"
 fi
 
-if want run; then
+if want tests; then
   log "test_discrete_filters (CUDA default space)"
   "$build/tests/test_discrete_filters" > "$out/test_discrete_filters.log" 2>&1 || status=1
   grep -E "OK|FAILED|PASSED|MOM order|PF N|squared error" "$out/test_discrete_filters.log"
   log "test_discrete_control (host)"
   "$build/tests/test_discrete_control" > "$out/test_discrete_control.log" 2>&1 || status=1
   grep -E "OK \]|FAILED|PASSED|J =|D =" "$out/test_discrete_control.log"
+fi
+
+if want filters; then
   for run in "clark --model clark-linear --filters all,EXACT --members 500 --particles 1024 --T 50 --seed 11" \
              "gauss --model linear-discrete --filters all --members 2000 --particles 1024 --T 50 --seed 12" \
+             "gauss-exact --model linear-discrete --filters KF,EXACT --members 100 --T 20 --seed 12" \
+             "duffing --model-file $here/models/examples/duffing_discrete.toml --filters all,EXACT --members 100 --particles 1024 --T 30 --seed 14" \
              "quintic --model clark-quintic --filters all,EXACT --members 1000 --particles 1024 --T 50 --seed 13 --set bound_w=0.3"; do
     set -- $run
     name=$1; shift
@@ -69,6 +77,9 @@ for part in ("vs truth", "vs PF"):
           {k[0]: float("%.2g" % v) for k, v in worst.items() if k[1] == part})
 PY
   done
+fi
+
+if want control; then
   for run in "control --model clark-linear --controllers NONE@state,LQR@state,LQR@KF,LQR@MOM,LQR@MOM-SPEC,LQR@PF --cost D=5" \
              "control-quintic --model clark-quintic --controllers LQR-NOM@KF-NOM,LQR-NOM@MOM-NOM,LQR-NOM@PF --set bound_w=0.3 --set x0_mean=2 --set prior_mean=2"; do
   set -- $run
@@ -86,6 +97,9 @@ for name in g:
           abs(g[name]["J"] - h[name]["J"]) / abs(h[name]["J"]), g[name]["estimation_error"]))
 PY
   done
+fi
+
+if want reproduce; then
   log "reproduce clark-table-2.1 at 20000 members (GPU)"
   KUSHNER_BACKEND=cuda /usr/bin/time -f "%e s wall, %M KB" "$build/kushner" reproduce clark-table-2.1 --members 20000 \
     --particles 4096 --out "$out/clark-table" --quiet --no-plots > "$out/clark-table.log" 2>&1 || status=1
@@ -94,6 +108,6 @@ PY
   KUSHNER_BACKEND=cuda /usr/bin/time -f "%e s wall, %M KB" "$build/kushner" reproduce clark-table-3.1 --members 20000 \
     --particles 1024 --out "$out/clark-table-3.1" --quiet --no-plots > "$out/clark-table-3.1.log" 2>&1 || status=1
   tail -25 "$out/clark-table-3.1.log"
-  log "done (status $status)"
 fi
+log "done (status $status)"
 exit $status

@@ -17,12 +17,19 @@ namespace kushner {
 
 namespace detail {
 
+/// A model known only at run time (a model file) is checked by discrete_kalman_unsupported_by instead.
 template <class Model>
 constexpr const char* discrete_kalman_unsupported() {
   if (!Model::discrete_time) return "continuous-time model (discrete-time filter)";
+  if (ModelTraits<Model>::runtime_checked) return nullptr;
   if (!DiscreteModelTraits<Model>::linear) return "transition is not linear";
   if (!DiscreteModelTraits<Model>::linear_observation) return "observation is not linear";
   return nullptr;
+}
+
+inline const char* discrete_kalman_unsupported_by(const ModelFacts& f) {
+  if (f.drift_degree > 1) return "transition is not linear (the file has terms of degree 2 or more)";
+  return observation_unsupported_by(f);
 }
 
 /// The prediction k -> k + 1 at (m, P) with the known input B u[k] (zero in open loop).
@@ -77,6 +84,7 @@ struct KalmanFilter : DiscreteKalmanStep<Model> {
   static constexpr const char* description =
       "discrete Kalman filter, covariance form (Tarushkin 1972; Clark 1971 ch. II)";
   static constexpr const char* unsupported = detail::discrete_kalman_unsupported<Model>();
+  static const char* unsupported_by(const ModelFacts& f) { return detail::discrete_kalman_unsupported_by(f); }
 
   static KalmanFilter create(const OptionValues&, const Model&, long) { return {}; }
 };
@@ -88,6 +96,7 @@ struct InformationFilter {
   static constexpr const char* description =
       "discrete Kalman filter, information form = recursive least squares (Tarushkin 1972 (4.9)-(4.17))";
   static constexpr const char* unsupported = detail::discrete_kalman_unsupported<Model>();
+  static const char* unsupported_by(const ModelFacts& f) { return detail::discrete_kalman_unsupported_by(f); }
 
   static InformationFilter create(const OptionValues&, const Model&, long) { return {}; }
 

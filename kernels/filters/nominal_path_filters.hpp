@@ -88,6 +88,11 @@ struct NominalKalmanFilter {
   static constexpr const char* description =
       "Kalman filter of the plant linearized along a nominal path (Clark 1971 ch. III perturbation loop)";
   static constexpr const char* unsupported = detail::nominal_filter_unsupported<Model>();
+  /// A model file's coefficients (its type declares a nonlinear transition and a linear observation).
+  static const char* unsupported_by(const ModelFacts& f) {
+    if (f.drift_degree <= 1) return "transition is linear (the nominal path changes nothing: use KF)";
+    return observation_unsupported_by(f);
+  }
 
   NominalPathState<Model, MemSpace> nominal;
 

@@ -2,9 +2,10 @@
 // Which exact (or grid) reference a model has, for `--filters EXACT`: the Kalman filter of the particle
 // filter's discretization for linear models, the Benes closed form for the Benes model, the grid filter for
 // the other models of state dimension 1 or 2 with axis-aligned noise (sine, cubic oscillator, OU), the discrete
-// grid filter for scalar discrete-time models with bounded noises (Clark's). `void` where there is none
-// (dimension 3; other discrete-time models: on the Gaussian linear one KF itself is exact).
+// grid filter for scalar discrete-time models with bounded noises (Clark's) and its Gaussian twin for the other
+// discrete-time models of dimension 1 or 2. `void` where there is none (dimension 3).
 #include "kernels/reference/benes_filter.hpp"
+#include "kernels/reference/discrete_gaussian_grid_filter.hpp"
 #include "kernels/reference/discrete_grid_filter.hpp"
 #include "kernels/reference/grid_filter.hpp"
 #include "kernels/reference/kalman_bucy_reference.hpp"
@@ -23,8 +24,10 @@ struct exact_reference {
 };
 template <class ExecSpace, class Model>
 struct exact_reference<ExecSpace, Model, std::enable_if_t<Model::discrete_time>> {
-  using type = std::conditional_t<Model::state_dim == 1 && DiscreteModelTraits<Model>::bounded_noises,
-                                  DiscreteGridFilter<ExecSpace, Model>, void>;
+  using type =
+      std::conditional_t<DiscreteModelTraits<Model>::bounded_noises,
+                         std::conditional_t<Model::state_dim == 1, DiscreteGridFilter<ExecSpace, Model>, void>,
+                         std::conditional_t<Model::state_dim <= 2, DiscreteGaussianGridFilter<ExecSpace, Model>, void>>;
 };
 template <class ExecSpace, int N>
 struct exact_reference<ExecSpace, LinearModel<N>> {

@@ -23,8 +23,8 @@ expect_refused "filter EKF does not support model 'clark-linear' (a continuous-t
   filter --model clark-linear --filters EKF
 expect_refused "filter KF does not support model 'sine' (a discrete-time filter; the model is continuous-time)" \
   filter --model sine --filters KF
-expect_refused "filter EXACT does not support model 'linear-discrete' (no grid filter for this discrete-time model (scalar, bounded noises only))" \
-  filter --model linear-discrete --filters KF,EXACT
+expect_refused "filter EXACT does not support model 'linear-discrete' (the discrete grid filter needs axis-aligned process noise (G G^T diagonal))" \
+  filter --model linear-discrete --filters KF,EXACT --set 'G=0.5,0.1;0,0.5'
 expect_refused "--mom-order: must be in 1 .. 14 (got 20)" filter --model clark-linear --filters MOM --mom-order 20
 
 # A run: every discrete filter, the particle filter and the grid Bayes filter on clark-linear; steps of 1.
@@ -49,9 +49,10 @@ print("clark-linear rmse_truth:", {n: round(f[n]["rmse_truth"], 4) for n in orde
 PY
 echo "ok: clark-linear filter run"
 
-# The nonlinear plant: EKF-D, KF and MOM along the nominal path (KF, MOM refused: nonlinear), the grid and the particle filter; the Gaussian linear model.
+# The nonlinear plant: EKF-D, KF and MOM along the nominal path (KF, MOM refused: nonlinear), the grid and the
+# particle filter; the Gaussian linear model with its grid Bayes filter (EXACT).
 "$kushner" filter --model clark-quintic --filters EKF-D,KF-NOM,MOM-NOM,PF,EXACT --members 100 --particles 256 --T 10 --out "$work/quintic" --quiet
-"$kushner" filter --model linear-discrete --filters all --members 100 --particles 256 --T 10 --out "$work/gauss" --quiet
+"$kushner" filter --model linear-discrete --filters all,EXACT --members 100 --particles 256 --T 10 --out "$work/gauss" --quiet
 python3 - "$work/quintic" "$work/gauss" <<'PY' || fail "clark-quintic or linear-discrete run"
 import json, sys
 q = json.load(open(sys.argv[1] + "/summary.json"))
@@ -59,10 +60,14 @@ assert q["filter_order"] == ["EKF-D", "KF-NOM", "MOM-NOM", "PF", "EXACT"], q["fi
 assert all(f["diverged"] == 0 for f in q["filters"].values()), q["filters"]
 assert q["filters"]["KF-NOM"]["nominal"].startswith("noise-free uncontrolled"), q["filters"]["KF-NOM"]
 g = json.load(open(sys.argv[2] + "/summary.json"))
-assert g["filter_order"] == ["KF", "KF-INF", "EKF-D", "PF"], g["filter_order"]
+assert g["filter_order"] == ["KF", "KF-INF", "EKF-D", "PF", "EXACT"], g["filter_order"]
 # On the Gaussian linear model KF is the exact filter: its distance to the particle filter is the particle
-# filter's own Monte Carlo error (its noise floor).
-assert g["filters"]["KF"]["rmse_ref"] < 1.5 * g["reference"]["noise_floor"], (g["filters"]["KF"], g["reference"])
+# filter's own Monte Carlo error (its noise floor). The grid Bayes filter (EXACT) is KF to its grid's error.
+gf = g["filters"]
+assert gf["KF"]["rmse_ref"] < 1.5 * g["reference"]["noise_floor"], (gf["KF"], g["reference"])
+assert gf["EXACT"]["estimator"]["kind"] == "grid" and gf["EXACT"]["diverged"] == 0, gf["EXACT"]
+assert abs(gf["EXACT"]["rmse_truth"] - gf["KF"]["rmse_truth"]) < 1e-6 * gf["KF"]["rmse_truth"], (gf["EXACT"], gf["KF"])
+assert abs(gf["EXACT"]["rmse_ref"] - gf["KF"]["rmse_ref"]) < 1e-6 * gf["KF"]["rmse_ref"], (gf["EXACT"], gf["KF"])
 PY
 echo "ok: clark-quintic and linear-discrete runs"
 

@@ -33,9 +33,15 @@ PolynomialModel<N> model_from_file(const std::string& name) {
 std::string parse_error(const std::string& text) {
   try {
     const PolynomialModelSpec spec = parse_polynomial_model(text, "m.toml");
-    if (spec.n == 1) make_polynomial_model<1>(spec, nullptr);
-    if (spec.n == 2) make_polynomial_model<2>(spec, nullptr);
-    if (spec.n == 3) make_polynomial_model<3>(spec, nullptr);
+    if (spec.discrete) {
+      if (spec.n == 1) make_polynomial_model<1, DiscretePolynomialModel<1>>(spec, nullptr);
+      if (spec.n == 2) make_polynomial_model<2, DiscretePolynomialModel<2>>(spec, nullptr);
+      if (spec.n == 3) make_polynomial_model<3, DiscretePolynomialModel<3>>(spec, nullptr);
+    } else {
+      if (spec.n == 1) make_polynomial_model<1>(spec, nullptr);
+      if (spec.n == 2) make_polynomial_model<2>(spec, nullptr);
+      if (spec.n == 3) make_polynomial_model<3>(spec, nullptr);
+    }
   } catch (const InputError& e) {
     return e.what();
   }
@@ -378,6 +384,32 @@ TEST(PolynomialModel, FileEqualToTheLinearModelGivesItsNumbersBitForBit) {
   expect_bitwise_equal(file.prior_cov, builtin.prior_cov, "prior_cov");
 }
 
+TEST(PolynomialModel, DiscreteFileEqualToTheLinearDiscreteModelGivesItsNumbersBitForBit) {
+  const PolynomialModelSpec spec = read_polynomial_model_file(examples + "linear_discrete.toml");
+  ASSERT_TRUE(spec.discrete);
+  const auto file = make_polynomial_model<2, DiscretePolynomialModel<2>>(spec, nullptr);
+  const LinearDiscreteModel builtin;
+  const Vec<1> u{{0.7}};
+  for (int point = 0; point < 20; ++point) {
+    const Vec<2> x = test_point<2>(point);
+    expect_bitwise_equal(file.transition(3.0, x, u), builtin.transition(3.0, x, u), "transition");
+    expect_bitwise_equal(file.transition_jacobian(3.0, x), builtin.transition_jacobian(3.0, x), "jacobian");
+    expect_bitwise_equal(file.process_noise(x, 0.5), builtin.process_noise(x, 0.5), "process noise");
+    expect_bitwise_equal(file.observation(4.0, x), builtin.observation(4.0, x), "observation");
+    expect_bitwise_equal(file.observation_noise_sample(x, 0.5), builtin.observation_noise_sample(x, 0.5), "v");
+    EXPECT_EQ(file.observation_log_density(x), builtin.observation_log_density(x));
+  }
+  expect_bitwise_equal(file.process_noise_covariance(0.0), builtin.process_noise_covariance(0.0), "Q");
+  expect_bitwise_equal(file.control_input(0.0), builtin.control_input(0.0), "B");
+  expect_bitwise_equal(file.prior_cov, builtin.prior_cov, "prior_cov");
+  // The same text without time = "discrete" is not a continuous model with other names: its tables are refused.
+  EXPECT_EQ(parse_error("state_dim = 2\n[transition]\na1 = [[1.0, 0.0], [0.0, 1.0]]\n" + minimal_tail),
+            "m.toml: transition: a continuous-time model has [drift] and [diffusion]; [transition] and "
+            "[process_noise] are a discrete one's (time = \"discrete\")");
+  EXPECT_EQ(parse_error("state_dim = 2\ntime = 1\n" + minimal_tail),
+            "m.toml: time: expected \"continuous\" or \"discrete\"");
+}
+
 TEST(PolynomialModel, FiltersTheCoefficientsRuleOutAreRefusedAtSelection) {
   const auto cubic = model_from_file<2>("cubic_oscillator.toml");
   const auto vdp = model_from_file<2>("van_der_pol.toml");
@@ -475,8 +507,8 @@ TEST(PolynomialModelFile, BadFilesNameTheFileAndTheKey) {
   EXPECT_EQ(parse_error("state_dim = 4\n" + minimal_tail), "m.toml: state_dim: must be 1, 2 or 3 (got 4)");
   EXPECT_EQ(parse_error("state_dim = 2.0\n" + minimal_tail), "m.toml: state_dim: expected an integer, got a number");
   EXPECT_EQ(parse_error("state_dim = 2\nstates = 3\n" + minimal_tail),
-            "m.toml: states: unknown key (known here: state_dim, name, description, drift, diffusion, observation, "
-            "control, initial)");
+            "m.toml: states: unknown key (known here: state_dim, time, name, description, drift, diffusion, "
+            "observation, control, initial)");
   EXPECT_EQ(parse_error("state_dim = 2\n[drift]\na5 = [1.0, 2.0]\n" + minimal_tail),
             "m.toml: drift.a5: unknown key (known here: a0, a1, a2, a3, a4, terms)");
   EXPECT_EQ(parse_error("state_dim = 2\n[drift]\na2 = [[1.0, 2.0], [3.0, 4.0]]\n" + minimal_tail),
