@@ -13,7 +13,6 @@ using impl::atan;
 using impl::atan2;
 using impl::cos;
 using impl::cosh;
-using impl::erfc;
 using impl::exp;
 using impl::expm1;
 using impl::fabs;
@@ -72,9 +71,6 @@ KOKKOS_INLINE_FUNCTION void cos_sin_two_pi(double u, double& c, double& s) {
   s = sin(pi * (2.0 * u));
 #endif
 }
-
-/// The standard normal CDF, accurate in both tails (erfc, not 1 + erf).
-KOKKOS_INLINE_FUNCTION double normal_cdf(double x) { return 0.5 * erfc(-0.70710678118654752440 * x); }
 
 /// log(cosh(x)) without overflow for large |x|.
 KOKKOS_INLINE_FUNCTION double log_cosh(double x) {
