@@ -174,6 +174,7 @@ std::string run_identity(const Model& model, const CompareOptions& options, cons
                         {"particles", particle.particles},
                         {"resample", options.resample},
                         {"ess_threshold", options.ess_threshold},
+                        {"precision", options.precision},
                         {"trajectory_members", options.trajectory_members},
                         {"density_times", density_times}}
       .dump();

@@ -57,6 +57,10 @@ void add_filter_options(CLI::App& app, FilterOptions& o) {
   app.add_option("--ess-threshold", o.ess_threshold,
                  "PF resamples a member when its effective sample size falls below this fraction of --particles")
       ->capture_default_str();
+  app.add_option("--precision", o.precision,
+                 "PF arithmetic: fp64, or mixed (normals drawn in fp32, state, weights and sums in fp64; faster on "
+                 "GPUs)")
+      ->capture_default_str();
   app.add_option_function<double>(
       "--checkpoint-every",
       [&o](double seconds) {
@@ -91,6 +95,15 @@ ParticleSettings particle_settings(const FilterOptions& o) {
                                                 << "' (known: multinomial, residual, stratified, systematic)");
   settings.options.scheme = *scheme;
   settings.options.ess_threshold = o.ess_threshold;
+  // fp32 (particles and log-weights in float) is named by users who know other codes' precision switches: say
+  // why it is not there rather than only listing what is.
+  KUSHNER_INPUT_REQUIRE(o.precision != "fp32",
+                        "--precision fp32: not available (the particle filter keeps particles "
+                        "and weights in fp64; mixed draws its normals in fp32)");
+  const std::optional<ParticlePrecision> precision = particle_precision_named(o.precision);
+  KUSHNER_INPUT_REQUIRE(precision.has_value(),
+                        "--precision: unknown precision '" << o.precision << "' (known: fp64, mixed)");
+  settings.options.precision = *precision;
   return settings;
 }
 

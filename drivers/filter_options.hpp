@@ -22,6 +22,7 @@ struct FilterOptions {
   int particles = ParticleSettings{}.particles;
   std::string resample = "systematic";
   double ess_threshold = ParticleFilterOptions{}.ess_threshold;
+  std::string precision = to_string(ParticleFilterOptions{}.precision);
   /// --checkpoint-every SECONDS: save the run's state into --out this often (`kushner resume`); < 0: not given.
   double checkpoint_every = -1.0;
   bool checkpoint_every_given = false;
@@ -38,14 +39,14 @@ struct CompareOptions : FilterOptions {
 };
 
 /// The run options plus --filters, every filter's declared options (--gh-nodes, --asre-tolerance, ...),
-/// --particles, --resample, --ess-threshold, --checkpoint-every.
+/// --particles, --resample, --ess-threshold, --precision, --checkpoint-every.
 void add_filter_options(CLI::App& app, FilterOptions& options);
 
 /// add_filter_options plus --trajectory-members, --density-times, --no-plots.
 void add_compare_options(CLI::App& app, CompareOptions& options);
 
-/// The particle filter's settings; InputError for a particle count below 1, an unknown scheme, a threshold
-/// outside [0, 1].
+/// The particle filter's settings; InputError for a particle count below 1, an unknown scheme or precision, a
+/// threshold outside [0, 1].
 ParticleSettings particle_settings(const FilterOptions& options);
 
 /// The command-line spelling of an option declared as `name`: "gh_nodes" -> "--gh-nodes".

@@ -27,6 +27,7 @@
 #include "kernels/particle_filter/copy_listed_members.hpp"
 #include "kernels/particle_filter/particle_block_step.hpp"
 #include "kernels/particle_filter/particle_posterior.hpp"
+#include "kernels/particle_filter/particle_precision.hpp"
 #include "kernels/particle_filter/particle_resample_step.hpp"
 #include "kernels/particle_filter/particle_team_pair_step.hpp"
 #include "kernels/particle_filter/particle_team_step.hpp"
@@ -59,6 +60,7 @@ struct ParticleFilterOptions {
   ParticleKernel kernel = ParticleKernel::automatic;
   int team_size = 0;             // team kernel and resampling: 0 = the backend's default
   int particles_per_thread = 0;  // team kernel: 0 = device_particles_per_thread
+  ParticlePrecision precision = ParticlePrecision::fp64;
 };
 
 template <class ExecSpace, class Model>
@@ -319,6 +321,7 @@ class ParticleFilterBank {
     d.step = step;
     d.num_particles = num_particles_;
     d.block_size = block_size_;
+    d.fp32_normals = options_.precision == ParticlePrecision::mixed;
     return d;
   }
 

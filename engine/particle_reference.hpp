@@ -94,6 +94,7 @@ class ParticleReference final : public ReferenceEstimator<typename ExecSpace::me
             {"particles", static_cast<long>(pf_.num_particles())},
             {"resampling", std::string(to_string(pf_.options().scheme))},
             {"ess_threshold", pf_.options().ess_threshold},
+            {"precision", std::string(to_string(pf_.options().precision))},
             {"mean_ess", steps_ > 0 ? ess_total / member_steps : std::nan("")},
             {"noise_floor", steps_ > 0 ? std::sqrt(squared_error_total / member_steps) : std::nan("")},
             {"resamples", resample_total},

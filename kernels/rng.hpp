@@ -10,6 +10,9 @@
 // Normals: each Philox block (4 x 32 bits) gives two 52-bit uniforms u1, u2 in (0, 1), and Box-Muller
 // turns them into two independent standard normals sqrt(-2 ln u1) (cos 2 pi u2, sin 2 pi u2). Box-Muller,
 // not a rejection method, so every member uses the same number of blocks per step and counters stay aligned.
+// The fp32 variant (the particle filter's `mixed` precision) takes 23-bit uniforms from the same blocks' high
+// words (the top bits of the 52-bit ones) and runs Box-Muller in float: the same normals to about 1e-7,
+// with the radius cut at sqrt(48 ln 2) = 5.77 (probability 2^-24 beyond it).
 // The truths take component i of their N normals from block i / 2 (normal_vector); the particle filter
 // gives both normals of a block to two particles (kernels/particle_filter/particle_draws.hpp).
 #include "core/math.hpp"
@@ -18,6 +21,7 @@
 #include <Random123/philox.h>
 
 #include <cstdint>
+#include <cstring>
 
 namespace kushner {
 
@@ -77,6 +81,16 @@ KOKKOS_INLINE_FUNCTION double uniform_open(std::uint32_t hi, std::uint32_t lo) {
 #endif
 }
 
+/// Uniform in (0, 1) from the top 23 bits of a 32-bit word: (k + 1/2) 2^-23, built as 1 + k 2^-23 from its bit
+/// pattern minus 1 - 2^-24, which is exact (Sterbenz), so every backend gets the same float and no integer
+/// conversion runs. Its top bits are those of uniform_open(word, any).
+KOKKOS_INLINE_FUNCTION float uniform_open_fp32(std::uint32_t word) {
+  const std::uint32_t bits = (word >> 9) | 0x3F800000u;
+  float one_plus;
+  std::memcpy(&one_plus, &bits, sizeof one_plus);
+  return one_plus - (1.0f - 0x1.0p-24f);
+}
+
 /// Two independent uniforms in (0, 1) from one Philox block.
 KOKKOS_INLINE_FUNCTION void uniform_pair(const RngKey& key, const Counter& c, double& u0, double& u1) {
   const r123array4x32 r = philox_block(key, c);
@@ -95,6 +109,15 @@ KOKKOS_INLINE_FUNCTION NormalPair box_muller(double u0, double u1) {
   double c, s;
   math::cos_sin_two_pi(u1, c, s);
   return {radius * c, radius * s};
+}
+
+/// box_muller in float (the particle filter's `mixed` precision): a GPU's fp32 log, sqrt and sincospi cost a
+/// fraction of their fp64 versions; the normals are returned as doubles for the fp64 state.
+KOKKOS_INLINE_FUNCTION NormalPair box_muller_fp32(float u0, float u1) {
+  const float radius = math::sqrt(-2.0f * math::log(u0));
+  float c, s;
+  math::cos_sin_two_pi(u1, c, s);
+  return {static_cast<double>(radius * c), static_cast<double>(radius * s)};
 }
 
 /// Two independent standard normals from one Philox block (Box-Muller).

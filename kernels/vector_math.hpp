@@ -1,6 +1,6 @@
 #pragma once
-// Makes GCC vectorize sin, cos, exp and log inside `#pragma omp simd` loops by declaring glibc's vector
-// variants (libmvec: _ZGV{b,c,d,e}N{2,4,8}v_sin, ...). glibc declares them only under -ffast-math
+// Makes GCC vectorize sin, cos, exp and log (and sinf, cosf, logf) inside `#pragma omp simd` loops by declaring glibc's
+// vector variants (libmvec: _ZGV{b,c,d,e}N{2,4,8}v_sin, ...). glibc declares them only under -ffast-math
 // (bits/math-vector.h), whose other effects (finite-math-only, reassociation) we do not want; GCC also
 // needs -fno-math-errno to call them (CMake sets both when KUSHNER_ENABLE_VECTOR_MATH is on).
 // It is most of the host particle step's speed (perf/particle_filter.md, CPU section). libmvec's results are within 4
@@ -16,6 +16,10 @@ __attribute__((simd("notinbranch"))) double sin(double) noexcept;
 __attribute__((simd("notinbranch"))) double cos(double) noexcept;
 __attribute__((simd("notinbranch"))) double exp(double) noexcept;
 __attribute__((simd("notinbranch"))) double log(double) noexcept;
+// The float ones: the particle filter's `mixed` precision draws its normals in float.
+__attribute__((simd("notinbranch"))) float sinf(float) noexcept;
+__attribute__((simd("notinbranch"))) float cosf(float) noexcept;
+__attribute__((simd("notinbranch"))) float logf(float) noexcept;
 }
 #endif
 

@@ -1,8 +1,8 @@
 // The whole particle-filter step (propagate, weight, block moments, posterior and ESS, amortized
-// resampling) in particle-steps per second, sine model, fp64, next to BM_StreamCopy of the bytes a step
-// must move (the memory floor) in the same binary. Observation increments come from a bank of truths that
-// is stepped outside the timed region. With steps = 2 each timed call is ParticleFilterBank::step_pair (two
-// steps, one pass over the particles on a GPU: half the bytes per particle-step).
+// resampling) in particle-steps per second, sine model, fp64 or mixed precision, next to BM_StreamCopy of the bytes a
+// step must move (the memory floor) in the same binary. Observation increments come from a bank of truths that is
+// stepped outside the timed region. With steps = 2 each timed call is ParticleFilterBank::step_pair (two steps, one
+// pass over the particles on a GPU: half the bytes per particle-step).
 #include "engine/particle_filter_bank.hpp"
 #include "engine/truth_bank.hpp"
 #include "models/sine_model.hpp"
@@ -33,6 +33,7 @@ void BM_ParticleFilterStep(benchmark::State& state) {
   ParticleFilterOptions options;
   if (state.range(3) == 0) options.ess_threshold = 0.0;  // never resample: the cost of the other kernels
   if (state.range(2) > 0) options.particles_per_thread = static_cast<int>(state.range(2));
+  if (state.range(5) == 1) options.precision = ParticlePrecision::mixed;
   ParticleFilterBank<Space, Model> pf(space, model, members, particles, 43, options);
   const bool pairs = state.range(4) == 2;
   BankVector<typename Space::memory_space> first_dy("first_dy", members, Model::obs_dim);
@@ -102,16 +103,19 @@ void BM_StreamCopy(benchmark::State& state) {
 // M x N: the CPU target (100 x 4096), then M.N = 1e6 .. 1e9; sizes past 1e7 only where a GPU runs them.
 // The third argument (GPU team kernel only) is particles per thread, 0 = the default; the fourth, 0, turns
 // resampling off (ESS threshold 0), which shows what resampling costs; the fifth is steps per timed call
-// (2: step_pair, which fuses them where the team kernel runs).
+// (2: step_pair, which fuses them where the team kernel runs); the sixth, 1, draws the normals in fp32 (the
+// `mixed` precision).
 BENCHMARK_TEMPLATE(BM_ParticleFilterStep, SineModel)
     ->Apply([](benchmark::internal::Benchmark* b) {
-      b->ArgNames({"members", "particles", "per_thread", "resample", "steps"});
-      b->Args({100, 4096, 0, 1, 1})->Args({1000, 1024, 0, 1, 1})->Args({1000, 16384, 0, 1, 1});
+      b->ArgNames({"members", "particles", "per_thread", "resample", "steps", "mixed"});
+      b->Args({100, 4096, 0, 1, 1, 0})->Args({1000, 1024, 0, 1, 1, 0})->Args({1000, 16384, 0, 1, 1, 0});
+      b->Args({100, 4096, 0, 1, 1, 1})->Args({1000, 16384, 0, 1, 1, 1});
 #if defined(KOKKOS_ENABLE_CUDA)
-      b->Args({1000, 65536, 0, 1, 1})->Args({10000, 65536, 0, 1, 1})->Args({15259, 65536, 0, 1, 1});
-      b->Args({1000, 65536, 8, 1, 1})->Args({1000, 65536, 32, 1, 1})->Args({1000, 65536, 0, 0, 1});
-      b->Args({1000, 65536, 0, 1, 2})->Args({1000, 65536, 0, 0, 2})->Args({1000, 1024, 0, 1, 2});
-      b->Args({1000, 16384, 0, 1, 2})->Args({10000, 65536, 0, 1, 2});
+      b->Args({1000, 65536, 0, 1, 1, 0})->Args({10000, 65536, 0, 1, 1, 0})->Args({15259, 65536, 0, 1, 1, 0});
+      b->Args({1000, 65536, 8, 1, 1, 0})->Args({1000, 65536, 32, 1, 1, 0})->Args({1000, 65536, 0, 0, 1, 0});
+      b->Args({1000, 65536, 0, 1, 2, 0})->Args({1000, 65536, 0, 0, 2, 0})->Args({1000, 1024, 0, 1, 2, 0});
+      b->Args({1000, 16384, 0, 1, 2, 0})->Args({10000, 65536, 0, 1, 2, 0});
+      b->Args({1000, 65536, 0, 1, 1, 1})->Args({1000, 65536, 0, 1, 2, 1})->Args({10000, 65536, 0, 1, 2, 1});
 #endif
     })
     ->UseManualTime();

@@ -58,8 +58,9 @@ def report_sizes(out, source):
         print(f"PF step {size}: median {rate:.3g} particle-steps/s (n={n}, spread {lo:.3g}..{hi:.3g}); "
               f"{nbytes:.0f} B/particle-step = {gbs:.0f} GB/s{frac}; resamples/member-step {res[0]:.2g}")
         for calls, key in (("1", "step"), ("2", "step_pair")):
-            if size == "members:1000/particles:65536/per_thread:0/resample:1/steps:" + calls:
-                target[key] = rate
+            for mixed, precision in (("0", ""), ("1", " mixed")):
+                if size == f"members:1000/particles:65536/per_thread:0/resample:1/steps:{calls}/mixed:{mixed}":
+                    target[key + precision] = rate
     return target
 
 
@@ -77,6 +78,18 @@ def report_power(out):
               f"{rows[0][3]} MHz, throttle reasons {' '.join(throttle)} (0x4: software power cap)")
 
 
+def report_other(out, stem, label, version_key, target):
+    """Another implementation's rates ({stem}.json, printed by perf/pf_torch.py or perf/pf_jax.py) and kushner's
+    rates over it."""
+    t = load(os.path.join(out, f"{stem}.json"))
+    if not (t and target):
+        print(f"{label}: no result (see {stem}.log)")
+        return
+    ratios = ", ".join(f"kushner {key} / {label} = {rate / t['median']:.3g}x" for key, rate in target.items())
+    print(f"{label} ({t[version_key]}): median {t['median']:.3g} particle-steps/s (spread {t['min']:.3g}.."
+          f"{t['max']:.3g}); {ratios}")
+
+
 def main():
     out = sys.argv[1]
     gpu_csv = os.path.join(out, "gpu.csv")
@@ -85,13 +98,19 @@ def main():
     report_power(out)
     print("-- PyTorch, same call as bench_compare.json")
     for mode in ("eager", "compile"):
-        t = load(os.path.join(out, f"torch_{mode}.json"))
-        if t and target:
-            ratios = ", ".join(f"kushner {key} / PyTorch {mode} = {rate / t['median']:.3g}x" for key, rate in target.items())
-            print(f"PyTorch {mode} ({t['torch']}): median {t['median']:.3g} particle-steps/s (spread {t['min']:.3g}.."
-                  f"{t['max']:.3g}); {ratios}")
+        report_other(out, f"torch_{mode}", f"PyTorch {mode}", "torch", target)
+    print("-- JAX (propagate, weight, moments; no resampling), same call")
+    for dtype in ("float64", "float32"):
+        report_other(out, f"jax_{dtype}", f"JAX {dtype}", "jax", target)
+    print("-- the command line (kushner filter --model sine --filters PF, M = 1000, N = 65536, 1000 steps), same call")
+    for precision, key in (("fp64", "step"), ("mixed", "step mixed")):
+        c = load(os.path.join(out, f"cli_{precision}.json"))
+        if c and "timing" in c:
+            rate = c["timing"]["particle_steps_per_s"]
+            versus = f", {rate / target[key]:.3f} of the benchmark's {key}" if key in target else ""
+            print(f"CLI {precision}: step loop {c['timing']['step_loop_s']:.3g} s, {rate:.3g} particle-steps/s{versus}")
         else:
-            print(f"PyTorch {mode}: no result (see torch_{mode}.log)")
+            print(f"CLI {precision}: no result (see cli_{precision}.log)")
     for key, rate in target.items():
         print(f"target >= 6e10 particle-steps/s at M=1000, N=65536 ({key}): {'met' if rate >= 6e10 else 'NOT met'} ({rate:.3g})")
     report_sizes(out, "bench_particle_filter.json")
@@ -99,8 +118,8 @@ def main():
     for name, rows in iterations(rs, "BM_Resample").items():
         m = med(rows, "particles_per_s")
         print(f"{name}: median {m[0]:.3g} particles/s (spread {m[1]:.3g}..{m[2]:.3g})")
-    for t in ("test_resampling", "test_particle_filter", "test_particle_filter_references", "test_grid_filter",
-              "test_particle_snapshot"):
+    for t in ("test_particle_random", "test_resampling", "test_particle_filter", "test_particle_filter_references",
+              "test_grid_filter", "test_particle_snapshot"):
         r = load(os.path.join(out, f"{t}.json"))
         print(f"{t}: {r['tests'] - r['failures']}/{r['tests']} passed" if r else f"{t}: no result")
 

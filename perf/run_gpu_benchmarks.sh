@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The particle filter on the GPU machine: builds the CUDA configuration, runs the particle-filter tests
 # (device vs host to 1e-12, systematic indices on every backend, the statistical references) and the
-# benchmarks, with the PyTorch version (perf/pf_torch.py, eager and torch.compile) timed in the same run.
+# benchmarks, with the PyTorch version (perf/pf_torch.py, eager and torch.compile) and the JAX one (perf/pf_jax.py,
+# fp64 and fp32) timed in the same run, and `kushner filter --filters PF` through the command line (fp64, mixed).
 # Needs: the repository with .deps (Kokkos source, googletest, benchmark, header-only libraries), CUDA,
 # CMake, Python with PyTorch. No network.
 #   OUT=<dir> perf/run_gpu_benchmarks.sh        (results in $OUT; default ./gpu-out)
@@ -9,8 +10,10 @@
 # KUSHNER_REPETITIONS (10), KUSHNER_PHASES (default "build test compare sizes"):
 #   build    configure and build build-cuda/ (kept between calls on the device machine)
 #   test     the particle-filter test binaries (device vs host, systematic indices, statistical references)
-#   compare  M = 1000, N = 65536: kushner's PF step and BM_StreamCopy (with power draw and SM clock sampled),
-#            then PyTorch eager and torch.compile, in the same call (the side-by-side ratio)
+#   compare  M = 1000, N = 65536: kushner's PF step (fp64 and mixed, step and step_pair) and BM_StreamCopy (with
+#            power draw and SM clock sampled), then PyTorch eager and torch.compile, JAX fp64 and fp32, and the
+#            command line `kushner filter --model sine --filters PF` (fp64, mixed; summary.json's step-loop
+#            rate), in the same call (the side-by-side ratios)
 #   sizes    every size M.N = 4e5 .. 1e9 (5 repetitions) and Kokkos vs Thrust resampling
 #   profile  Nsight Compute (ncu, where installed) on one launch of each step kernel at M = 1000, N = 65536:
 #            duration, throughput, occupancy, issue-slot use (ncu locks the clocks to base: durations are
@@ -50,12 +53,14 @@ if want build; then
 run configure cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON \
   -DKUSHNER_ENABLE_OPENMP=OFF -DKUSHNER_ENABLE_THRUST=ON -DKUSHNER_CUDA_ARCH="$arch" || { echo "configure failed"; exit 1; }
 run build cmake --build "$build" -j"$jobs" --target test_resampling test_particle_filter \
-  test_particle_filter_references test_grid_filter test_particle_snapshot bench_particle_filter bench_resampling ||
+  test_particle_filter_references test_grid_filter test_particle_snapshot test_particle_random bench_particle_filter \
+  bench_resampling kushner ||
   { tail -50 "$out/build.log"; exit 1; }
 fi
 
 if want test; then
-  for t in test_resampling test_particle_filter test_particle_filter_references test_grid_filter test_particle_snapshot; do
+  for t in test_particle_random test_resampling test_particle_filter test_particle_filter_references test_grid_filter \
+    test_particle_snapshot; do
     run "$t" "$build/tests/$t" --gtest_output=json:"$out/$t.json"
   done
 fi
@@ -74,6 +79,19 @@ if want compare; then
   run torch_compile python3 "$here/perf/pf_torch.py" --mode compile --members 1000 --particles 65536 --repetitions "$reps"
   tail -n 1 "$out/torch_eager.log" > "$out/torch_eager.json" 2>/dev/null
   tail -n 1 "$out/torch_compile.log" > "$out/torch_compile.json" 2>/dev/null
+  for dtype in float64 float32; do
+    run "jax_$dtype" python3 "$here/perf/pf_jax.py" --dtype "$dtype" --members 1000 --particles 65536 --repetitions "$reps"
+    tail -n 1 "$out/jax_$dtype.log" > "$out/jax_$dtype.json" 2>/dev/null
+  done
+  # The command line: 1000 steps (dt 1e-3), the default 200 output points, no progress bar; summary.json's
+  # timing.particle_steps_per_s is the step loop's rate (start-up and writing excluded).
+  for precision in fp64 mixed; do
+    rm -rf "$out/cli_$precision"
+    run "cli_$precision" "$build/kushner" filter --model sine --filters PF --members 1000 --particles 65536 \
+      --T 1 --dt 1e-3 --precision "$precision" --quiet --out "$out/cli_$precision"
+    cp "$out/cli_$precision/summary.json" "$out/cli_$precision.json" 2>/dev/null
+    rm -rf "$out/cli_$precision"
+  done
 fi
 if want sizes; then
   run bench_particle_filter "$build/perf/bench_particle_filter" --benchmark_repetitions=5 \

@@ -1,8 +1,9 @@
 // The particle filter against exact references: its posterior mean's RMS distance to the exact posterior
-// mean shrinks like N^{-1/2} (fitted slope in [-0.6, -0.4] over N = 2^8 .. 2^14) and, at N = 2^14, its bias
+// mean shrinks like N^{-1/2} (fitted slope in [-0.6, -0.4] over N = 2^8 .. 2^16) and, at N = 2^16, its bias
 // is within 4 Monte Carlo standard errors of zero -- for the linear model (1-D and 2-D, against the Kalman
-// filter of the same discretization) and the Benes model (against the closed form). Power: the same runs
-// must reject a reference that is slightly wrong (a drift offset, a shifted prior).
+// filter of the same discretization) and the Benes model (against the closed form), in both precisions (fp64,
+// and mixed: normals drawn in fp32). Power: the same runs must reject a reference that is slightly wrong (a
+// drift offset, a shifted prior).
 #include "engine/particle_filter_bank.hpp"
 #include "kernels/reference/benes_filter.hpp"
 #include "kernels/reference/kalman_bucy_reference.hpp"
@@ -12,6 +13,9 @@
 
 #include <gtest/gtest.h>
 
+#include <iostream>
+#include <string>
+
 namespace kushner {
 namespace {
 
@@ -19,7 +23,7 @@ using test::Space;
 
 constexpr int members = 32, steps = 100;
 constexpr double dt = 0.01;
-const std::vector<double> particle_counts = {256, 1024, 4096, 16384};
+const std::vector<double> particle_counts = {256, 1024, 4096, 16384, 65536};
 
 struct Convergence {
   std::vector<double> rms;  // per particle count
@@ -31,13 +35,15 @@ struct Convergence {
 
 /// Runs the particle filter at every count on the same observations and compares with `exact` and `wrong`.
 template <class Model>
-Convergence converge(const Model& model, const std::vector<BankVector<test::Mem>>& dys, const test::Trajectory& exact,
-                     const test::Trajectory& wrong) {
+Convergence converge(const Model& model, ParticlePrecision precision, const std::vector<BankVector<test::Mem>>& dys,
+                     const test::Trajectory& exact, const test::Trajectory& wrong) {
+  ParticleFilterOptions options;
+  options.precision = precision;
   Convergence c;
   std::vector<double> wrong_rms;
   test::Trajectory largest;
   for (double n : particle_counts) {
-    ParticleFilterBank<Space, Model> pf(Space(), model, members, static_cast<int>(n), 4321);
+    ParticleFilterBank<Space, Model> pf(Space(), model, members, static_cast<int>(n), 4321, options);
     largest = test::replay(pf, dys, dt);
     c.rms.push_back(test::rms_distance(largest, exact));
     wrong_rms.push_back(test::rms_distance(largest, wrong));
@@ -51,12 +57,13 @@ Convergence converge(const Model& model, const std::vector<BankVector<test::Mem>
   return c;
 }
 
-void expect_converges(const Convergence& c, const char* what) {
+void expect_converges(const Convergence& c, const std::string& what) {
   std::string summary = "slope " + std::to_string(c.slope) + ", wrong-reference slope " + std::to_string(c.wrong_slope);
   for (std::size_t i = 0; i < c.bias.size(); ++i)
     summary += "; bias[" + std::to_string(i) + "] " + std::to_string(c.bias[i].mean) + " +- " +
                std::to_string(c.bias[i].standard_error) + " (wrong: " + std::to_string(c.wrong_bias[i].mean) + ")";
   ::testing::Test::RecordProperty(what, summary);
+  std::cout << what << ": " << summary << "\n";
   EXPECT_GE(c.slope, -0.6) << what << ": RMS " << ::testing::PrintToString(c.rms);
   EXPECT_LE(c.slope, -0.4) << what << ": RMS " << ::testing::PrintToString(c.rms);
   for (std::size_t i = 0; i < c.bias.size(); ++i)
@@ -70,7 +77,7 @@ void expect_converges(const Convergence& c, const char* what) {
 }
 
 template <int N>
-void linear_model_case() {
+void linear_model_case(ParticlePrecision precision) {
   LinearModel<N> model;
   const auto dys = test::record_observations(model, members, steps, dt, 99);
   KalmanBucyReference<Space, N> kb(Space(), model, members);
@@ -79,14 +86,11 @@ void linear_model_case() {
   off.a0 = Vec<N>::constant(0.1);
   KalmanBucyReference<Space, N> kb_off(Space(), off, members);
   const auto wrong = test::replay(kb_off, dys, dt);
-  const auto c = converge(model, dys, exact, wrong);
-  expect_converges(c, N == 1 ? "linear 1-D" : "linear 2-D");
+  const auto c = converge(model, precision, dys, exact, wrong);
+  expect_converges(c, std::string(N == 1 ? "linear 1-D " : "linear 2-D ") + to_string(precision));
 }
 
-TEST(ParticleFilterAgainstKalman, LinearOneDimensionalConvergesAtRootNWithoutBias) { linear_model_case<1>(); }
-TEST(ParticleFilterAgainstKalman, LinearTwoDimensionalConvergesAtRootNWithoutBias) { linear_model_case<2>(); }
-
-TEST(ParticleFilterAgainstBenes, ClosedFormConvergesAtRootNWithoutBias) {
+void benes_case(ParticlePrecision precision) {
   BenesModel model;
   const auto dys = test::record_observations(model, members, steps, dt, 98);
   BenesFilter<Space> exact_filter(Space(), model, members);
@@ -95,8 +99,27 @@ TEST(ParticleFilterAgainstBenes, ClosedFormConvergesAtRootNWithoutBias) {
   off.prior_mean[0] += 0.3;
   BenesFilter<Space> off_filter(Space(), off, members);
   const auto wrong = test::replay(off_filter, dys, dt);
-  const auto c = converge(model, dys, exact, wrong);
-  expect_converges(c, "benes");
+  const auto c = converge(model, precision, dys, exact, wrong);
+  expect_converges(c, std::string("benes ") + to_string(precision));
+}
+
+TEST(ParticleFilterAgainstKalman, LinearOneDimensionalConvergesAtRootNWithoutBias) {
+  linear_model_case<1>(ParticlePrecision::fp64);
+}
+TEST(ParticleFilterAgainstKalman, LinearTwoDimensionalConvergesAtRootNWithoutBias) {
+  linear_model_case<2>(ParticlePrecision::fp64);
+}
+TEST(ParticleFilterAgainstBenes, ClosedFormConvergesAtRootNWithoutBias) { benes_case(ParticlePrecision::fp64); }
+
+// The mixed precision: the same test on the same observations.
+TEST(MixedPrecisionParticleFilterAgainstKalman, LinearOneDimensionalConvergesAtRootNWithoutBias) {
+  linear_model_case<1>(ParticlePrecision::mixed);
+}
+TEST(MixedPrecisionParticleFilterAgainstKalman, LinearTwoDimensionalConvergesAtRootNWithoutBias) {
+  linear_model_case<2>(ParticlePrecision::mixed);
+}
+TEST(MixedPrecisionParticleFilterAgainstBenes, ClosedFormConvergesAtRootNWithoutBias) {
+  benes_case(ParticlePrecision::mixed);
 }
 
 TEST(KalmanBucyReference, ConvergesToTheStationaryRiccatiSolutionAsDtShrinks) {

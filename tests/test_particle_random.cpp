@@ -1,10 +1,12 @@
 // The host particle kernel's vectorizable Philox (kernels/particle_filter/simd_random.hpp) against Random123's
 // (kernels/rng.hpp, used on the GPU): the same uniforms bit for bit, the same normals to the last bits of the
-// math library; and the particle pairs' draws (kernels/particle_filter/particle_draws.hpp).
+// math library; and the particle pairs' draws (kernels/particle_filter/particle_draws.hpp), in fp64 and in the
+// `mixed` precision's fp32.
 #include "kernels/particle_filter/particle_draws.hpp"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace kushner {
@@ -80,6 +82,82 @@ TEST(SimdPhilox, ExtremeWordsGiveTheOpenIntervalEnds) {
   EXPECT_EQ(simd::uniform_open(0, 0), 0x1.0p-53);
   EXPECT_EQ(simd::uniform_open(0xffffffffu, 0xffffffffu), 1.0 - 0x1.0p-53);
   EXPECT_EQ(simd::uniform_open(0xffffffffu, 0xffffffffu), uniform_open(0xffffffffu, 0xffffffffu));
+}
+
+TEST(MixedPrecisionDraws, Fp32UniformsAreTheTopBitsOfTheFp64OnesOnBothPhiloxes) {
+  // The same blocks' high words: within half a 2^-23 step (plus the fp64 offset) of the fp64 uniforms, the same
+  // floats from both Philox implementations, and the interval's ends (k + 1/2) 2^-23 exactly.
+  for (std::uint32_t member = 0; member < 40; member += 3)
+    for (std::uint32_t particle : {0u, 1u, 255u, 65535u, 0xfffffffeu})
+      for (std::uint32_t step : {0u, 3u, 999999u}) {
+        const RngKey key{20261126, Stream::particle_noise};
+        const Counter c{member, particle, step, 1};
+        double a0, a1;
+        float f0, f1, g0, g1;
+        uniform_pair(key, c, a0, a1);
+        Random123Draws::uniforms_fp32(key, c, f0, f1);
+        SimdDraws::uniforms_fp32(key, c, g0, g1);
+        ASSERT_EQ(f0, g0);
+        ASSERT_EQ(f1, g1);
+        ASSERT_LE(std::abs(f0 - a0), 0x1.0p-24);
+        ASSERT_LE(std::abs(f1 - a1), 0x1.0p-24);
+      }
+  EXPECT_EQ(uniform_open_fp32(0), 0x1.0p-24f);
+  EXPECT_EQ(uniform_open_fp32(0xffffffffu), 1.0f - 0x1.0p-24f);
+  EXPECT_EQ(uniform_open_fp32(0x80000000u), 0.5f + 0x1.0p-24f);
+}
+
+TEST(MixedPrecisionDraws, Fp32NormalsAgreeWithTheFp64OnesToFloatRounding) {
+  // Box-Muller in float against the double one on the same float uniforms: float rounding only (log, sqrt,
+  // cos, sin: a few 6e-8 relative steps, times a radius of at most 5.77), on both Philoxes. Against the fp64
+  // normals (52-bit uniforms of the same blocks) the uniforms' rounding (at most 2^-24) moves the radius r by
+  // up to 2^-24 / (u0 r) and the point across it by 2 pi 2^-24 r: each pair within that plus float rounding.
+  const RngKey key{5, Stream::particle_noise};
+  double worst = 0.0;
+  for (int pair = 0; pair < 100000; ++pair) {
+    const Counter c{9, std::uint32_t(pair), 2, 0};
+    double u0, u1;
+    float f0, f1;
+    uniform_pair(key, c, u0, u1);
+    Random123Draws::uniforms_fp32(key, c, f0, f1);
+    const NormalPair exact = box_muller(f0, f1);
+    const double r = std::hypot(exact.z0, exact.z1);
+    for (const NormalPair z :
+         {pair_normals<Random123Draws, true>(key, 9, pair, 2, 0), pair_normals<SimdDraws, true>(key, 9, pair, 2, 0)}) {
+      ASSERT_NEAR(z.z0, exact.z0, 1e-6 * (1.0 + r)) << pair;
+      ASSERT_NEAR(z.z1, exact.z1, 1e-6 * (1.0 + r)) << pair;
+    }
+    const NormalPair a = pair_normals<Random123Draws>(key, 9, pair, 2, 0);
+    const NormalPair b = pair_normals<Random123Draws, true>(key, 9, pair, 2, 0);
+    const double ra = std::hypot(a.z0, a.z1);
+    if (ra < 1e-3) continue;  // the radius' bound grows without limit as u0 -> 1
+    const double bound = 0x1.0p-24 / (u0 * ra) + 2.0 * math::pi * 0x1.0p-24 * ra + 1e-6 * (1.0 + ra);
+    ASSERT_LE(std::hypot(a.z0 - b.z0, a.z1 - b.z1), bound) << pair << " u0 " << u0 << " r " << ra;
+    worst = std::max(worst, std::hypot(a.z0 - b.z0, a.z1 - b.z1));
+  }
+  EXPECT_GT(worst, 0.0);  // they are float normals
+}
+
+TEST(MixedPrecisionDraws, Fp32NormalsAreUnitNormals) {
+  // As PairedNormalsAreUncorrelatedUnitNormals, plus the fourth moment (3, SE sqrt(96 / n)): the radius cut at
+  // 5.77 sd removes a probability of 2^-24, far below what 2^20 pairs resolve.
+  const int pairs = 1 << 20;
+  const RngKey key{13, Stream::particle_noise};
+  double s1 = 0.0, see = 0.0, soo = 0.0, seo = 0.0, s4 = 0.0;
+  for (int k = 0; k < pairs; ++k) {
+    const NormalPair z = pair_normals<SimdDraws, true>(key, 2, k, 4, 0);
+    s1 += z.z0 + z.z1;
+    see += z.z0 * z.z0;
+    soo += z.z1 * z.z1;
+    seo += z.z0 * z.z1;
+    s4 += z.z0 * z.z0 * z.z0 * z.z0;
+  }
+  const double n = pairs;
+  EXPECT_LT(std::abs(s1 / (2 * n)), 5.0 / std::sqrt(2 * n));
+  EXPECT_LT(std::abs(see / n - 1.0), 5.0 * std::sqrt(2.0 / n));
+  EXPECT_LT(std::abs(soo / n - 1.0), 5.0 * std::sqrt(2.0 / n));
+  EXPECT_LT(std::abs(seo / n), 5.0 / std::sqrt(n));
+  EXPECT_LT(std::abs(s4 / n - 3.0), 5.0 * std::sqrt(96.0 / n));
 }
 
 }  // namespace

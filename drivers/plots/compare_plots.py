@@ -218,7 +218,8 @@ def write_report(directory, summary, figures, no_figures=None):
     if ref:
         if ref.get("kind") == "particle filter":
             lines.append(f"- reference: particle filter with {ref.get('particles')} particles per member "
-                         f"({ref.get('resampling')} resampling below ESS {ref.get('ess_threshold')} N), mean ESS "
+                         f"({ref.get('resampling')} resampling below ESS {ref.get('ess_threshold')} N, "
+                         f"{ref.get('precision', 'fp64')} precision), mean ESS "
                          f"{fmt(ref.get('mean_ess'))}, resampling events {ref.get('resamples')}; its own Monte Carlo "
                          f"error (noise floor of rmse_ref) {fmt(ref.get('noise_floor'))}")
         else:

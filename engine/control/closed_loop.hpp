@@ -164,7 +164,8 @@ class ControlLoop {
     });
     if (pf_)
       fields = {{"particles", static_cast<long>(pf_->num_particles())},
-                {"resampling", std::string(to_string(pf_->options().scheme))}};
+                {"resampling", std::string(to_string(pf_->options().scheme))},
+                {"precision", std::string(to_string(pf_->options().precision))}};
     return fields;
   }
 

@@ -13,6 +13,20 @@
 
 namespace kushner {
 
+/// The normals of `pairs` particle pairs from first_pair on, component i in z[i][particle]; in float with Fp32.
+template <bool Fp32, int K>
+inline void draw_block_normals(const RngKey& key, int member, int first_pair, int pairs, std::uint32_t step,
+                               double (&z)[K][host_particle_block]) {
+  for (int i = 0; i < K; ++i) {
+    KUSHNER_SIMD
+    for (int k = 0; k < pairs; ++k) {
+      const NormalPair zk = pair_normals<SimdDraws, Fp32>(key, member, first_pair + k, step, i);
+      z[i][2 * k] = zk.z0;
+      z[i][2 * k + 1] = zk.z1;
+    }
+  }
+}
+
 /// The host kernel's work for one block: a function of the model and the data only (not of the execution
 /// space), so Serial and OpenMP run the same machine code and give the same bits (kernels/for_each_member.hpp).
 template <bool Initialize, class Model>
@@ -35,14 +49,10 @@ KUSHNER_SAME_CODE_FOR_ALL_CALLERS void particle_block_host(const ParticleStepDat
   const std::uint32_t step = particle_draw_step<Initialize>(d);
   const int first_pair = begin / 2;   // blocks start at even particles
   const int pairs = (count + 1) / 2;  // an odd count's last particle is the even half of its pair
-  for (int i = 0; i < K; ++i) {
-    KUSHNER_SIMD
-    for (int k = 0; k < pairs; ++k) {
-      const NormalPair zk = pair_normals<SimdDraws>(key, member, first_pair + k, step, i);
-      z[i][2 * k] = zk.z0;
-      z[i][2 * k + 1] = zk.z1;
-    }
-  }
+  if (d.fp32_normals)
+    draw_block_normals<true, K>(key, member, first_pair, pairs, step, z);
+  else
+    draw_block_normals<false, K>(key, member, first_pair, pairs, step, z);
   if constexpr (draws_uniform<Model, Initialize>) {
     KUSHNER_SIMD
     for (int k = 0; k < pairs; ++k) {

@@ -5,7 +5,9 @@
 // i = K (after the K normals) for one uniform each. So one Philox block, one log and one square root serve two
 // particles: the GPU step is bound by instruction issue, and Box-Muller with one normal per block was a
 // quarter of it (perf/particle_filter.md). Random123Draws (GPU) and SimdDraws (the host's SIMD kernel) give
-// the same uniforms bit for bit (tests/test_particle_random.cpp).
+// the same uniforms bit for bit (tests/test_particle_random.cpp). With `Fp32` (the `mixed` precision) the normals
+// come from the same blocks by the float Box-Muller (kernels/rng.hpp); the uniforms of exact transition
+// samplers stay fp64.
 #include "kernels/particle_filter/simd_random.hpp"
 #include "kernels/rng.hpp"
 
@@ -18,6 +20,11 @@ struct Random123Draws {
   KOKKOS_INLINE_FUNCTION static void uniforms(const RngKey& key, const Counter& c, double& u0, double& u1) {
     uniform_pair(key, c, u0, u1);
   }
+  KOKKOS_INLINE_FUNCTION static void uniforms_fp32(const RngKey& key, const Counter& c, float& u0, float& u1) {
+    const r123array4x32 r = philox_block(key, c);
+    u0 = uniform_open_fp32(r.v[0]);
+    u1 = uniform_open_fp32(r.v[2]);
+  }
 };
 
 /// The same uniforms from the vectorizable Philox (host block kernel).
@@ -25,14 +32,25 @@ struct SimdDraws {
   KOKKOS_INLINE_FUNCTION static void uniforms(const RngKey& key, const Counter& c, double& u0, double& u1) {
     simd::uniform_pair(key, c, u0, u1);
   }
+  KOKKOS_INLINE_FUNCTION static void uniforms_fp32(const RngKey& key, const Counter& c, float& u0, float& u1) {
+    simd::uniform_pair_fp32(key, c, u0, u1);
+  }
 };
 
-/// Component i of the normals of particles 2 pair (z0) and 2 pair + 1 (z1) of `member` at `step`.
-template <class Draws>
+/// Component i of the normals of particles 2 pair (z0) and 2 pair + 1 (z1) of `member` at `step`; in float
+/// with Fp32.
+template <class Draws, bool Fp32 = false>
 KOKKOS_INLINE_FUNCTION NormalPair pair_normals(const RngKey& key, int member, int pair, std::uint32_t step, int i) {
-  double u0, u1;
-  Draws::uniforms(key, Counter{std::uint32_t(member), std::uint32_t(pair), step, std::uint32_t(i)}, u0, u1);
-  return box_muller(u0, u1);
+  const Counter c{std::uint32_t(member), std::uint32_t(pair), step, std::uint32_t(i)};
+  if constexpr (Fp32) {
+    float u0, u1;
+    Draws::uniforms_fp32(key, c, u0, u1);
+    return box_muller_fp32(u0, u1);
+  } else {
+    double u0, u1;
+    Draws::uniforms(key, c, u0, u1);
+    return box_muller(u0, u1);
+  }
 }
 
 /// The uniforms of particles 2 pair (u0) and 2 pair + 1 (u1) whose draws also hold K normals each.

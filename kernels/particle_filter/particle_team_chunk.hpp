@@ -57,11 +57,11 @@ KOKKOS_INLINE_FUNCTION void load_particle_batch(const double* xm, const double* 
 /// The batch's draws at `step`.
 template <class Model, bool Initialize>
 KOKKOS_INLINE_FUNCTION void draw_particle_batch(const RngKey& key, int member, int base, int threads,
-                                                std::uint32_t step, Vec<particle_draw_dim<Model, Initialize>>* z,
-                                                double* u) {
+                                                std::uint32_t step, bool fp32,
+                                                Vec<particle_draw_dim<Model, Initialize>>* z, double* u) {
   KUSHNER_DEVICE_UNROLL
   for (int b = 0; b < device_pairs_per_batch; ++b)
-    draw_particle_pair<Model, Initialize>(key, member, base + b * threads, step, z[2 * b], z[2 * b + 1], u[2 * b],
+    draw_particle_pair<Model, Initialize>(key, member, base + b * threads, step, fp32, z[2 * b], z[2 * b + 1], u[2 * b],
                                           u[2 * b + 1]);
 }
 

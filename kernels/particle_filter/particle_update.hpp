@@ -46,7 +46,8 @@ struct ParticleStepData {
   Seed seed;
   std::uint32_t step = 0;
   int num_particles = 0, block_size = 0;
-  bool initialize = false;  // sample the initial law instead of propagating; no observation
+  bool initialize = false;    // sample the initial law instead of propagating; no observation
+  bool fp32_normals = false;  // the `mixed` precision (particle_precision.hpp)
 };
 
 /// The second step of a fused pair (particle_team_pair_step.hpp): step + 1, over [t, t + dt]. The pair reads the
@@ -81,15 +82,17 @@ KOKKOS_INLINE_FUNCTION std::uint32_t particle_draw_step(const ParticleStepData<M
 }
 
 /// The draws of particles 2 pair (z0, u0) and 2 pair + 1 (z1, u1) of `member` at `step`, from Random123's Philox
-/// (the team kernels; the host kernel draws a block at a time with SimdDraws, the same bits).
+/// (the team kernels; the host kernel draws a block at a time with SimdDraws, the same bits); normals in float
+/// with `fp32` (ParticleStepData::fp32_normals, the same for every thread: no divergence).
 template <class Model, bool Initialize>
-KOKKOS_INLINE_FUNCTION void draw_particle_pair(const RngKey& key, int member, int pair, std::uint32_t step,
+KOKKOS_INLINE_FUNCTION void draw_particle_pair(const RngKey& key, int member, int pair, std::uint32_t step, bool fp32,
                                                Vec<particle_draw_dim<Model, Initialize>>& z0,
                                                Vec<particle_draw_dim<Model, Initialize>>& z1, double& u0, double& u1) {
   constexpr int K = particle_draw_dim<Model, Initialize>;
   KUSHNER_DEVICE_UNROLL
   for (int i = 0; i < K; ++i) {
-    const NormalPair zi = pair_normals<Random123Draws>(key, member, pair, step, i);
+    const NormalPair zi = fp32 ? pair_normals<Random123Draws, true>(key, member, pair, step, i)
+                               : pair_normals<Random123Draws>(key, member, pair, step, i);
     z0[i] = zi.z0;
     z1[i] = zi.z1;
   }

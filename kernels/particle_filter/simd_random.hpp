@@ -58,4 +58,13 @@ KOKKOS_INLINE_FUNCTION void uniform_pair(const RngKey& key, const Counter& c, do
   u1 = uniform_open(r[2], r[3]);
 }
 
+/// The fp32 uniforms of the same block (kushner::uniform_open_fp32 of its high words).
+KOKKOS_INLINE_FUNCTION void uniform_pair_fp32(const RngKey& key, const Counter& c, float& u0, float& u1) {
+  std::uint64_t r[4];
+  philox4x32_10(c.member + key.seed.first_member, c.particle, c.step, c.draw, key.seed.value,
+                static_cast<std::uint32_t>(key.stream), r);
+  u0 = kushner::uniform_open_fp32(static_cast<std::uint32_t>(r[0]));
+  u1 = kushner::uniform_open_fp32(static_cast<std::uint32_t>(r[2]));
+}
+
 }  // namespace kushner::simd

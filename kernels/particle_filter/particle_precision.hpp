@@ -1,0 +1,31 @@
+#pragma once
+// The particle filter's arithmetic precision, and its names.
+#include <optional>
+#include <string>
+
+namespace kushner {
+
+/// fp64: every number in double. mixed: particles, weights and every sum in double, the normals of the particles'
+/// noise and initial states drawn in float from the same Philox blocks (kernels/rng.hpp): a GPU's fp32 log, sqrt
+/// and sincospi cost a fraction of the fp64 ones, and the step's Box-Muller was most of its instructions
+/// (perf/particle_filter.md). The normals agree with fp64's to about 1e-7 and are cut at 5.77 standard deviations
+/// of the radius (probability 2^-24 beyond); tests/test_particle_filter_references.cpp checks both for bias
+/// against exact filters.
+enum class ParticlePrecision { fp64, mixed };
+
+inline const char* to_string(ParticlePrecision p) {
+  switch (p) {
+    case ParticlePrecision::fp64: return "fp64";
+    case ParticlePrecision::mixed: return "mixed";
+  }
+  return "unknown";
+}
+
+/// The precision called `name`, if there is one.
+inline std::optional<ParticlePrecision> particle_precision_named(const std::string& name) {
+  for (auto p : {ParticlePrecision::fp64, ParticlePrecision::mixed})
+    if (name == to_string(p)) return p;
+  return std::nullopt;
+}
+
+}  // namespace kushner
