@@ -123,6 +123,21 @@ nlohmann::json polynomial_model_json(const Model& model) {
   return j;
 }
 
+namespace detail {
+
+/// Calls run(Family<n>*) for a model file's state dimension n (1 to 3, checked where the file is read).
+template <template <int> class Family, class Run>
+void with_state_dim(int n, Run& run) {
+  switch (n) {
+    case 1: run(static_cast<Family<1>*>(nullptr)); break;
+    case 2: run(static_cast<Family<2>*>(nullptr)); break;
+    case 3: run(static_cast<Family<3>*>(nullptr)); break;
+    default: KUSHNER_REQUIRE(false, "read_polynomial_model_file let state_dim " << n << " through");
+  }
+}
+
+}  // namespace detail
+
 /// Reads the model file `path`, applies `sets` ("key=value": the initial law, x0_mean, x0_cov, prior_mean,
 /// prior_cov; the rest is edited in the file), validates the model and calls f(model) with a
 /// PolynomialModel<state_dim> (DiscretePolynomialModel<state_dim> for time = "discrete"). InputError for a bad
@@ -155,15 +170,10 @@ void with_model_file(const std::string& path, const std::vector<std::string>& se
     validate_model(model);
     f(model);
   };
-  switch (spec.n * (spec.discrete ? -1 : 1)) {
-    case 1: run(static_cast<PolynomialModel<1>*>(nullptr)); break;
-    case 2: run(static_cast<PolynomialModel<2>*>(nullptr)); break;
-    case 3: run(static_cast<PolynomialModel<3>*>(nullptr)); break;
-    case -1: run(static_cast<DiscretePolynomialModel<1>*>(nullptr)); break;
-    case -2: run(static_cast<DiscretePolynomialModel<2>*>(nullptr)); break;
-    case -3: run(static_cast<DiscretePolynomialModel<3>*>(nullptr)); break;
-    default: KUSHNER_REQUIRE(false, "read_polynomial_model_file let state_dim " << spec.n << " through");
-  }
+  if (spec.discrete)
+    detail::with_state_dim<DiscretePolynomialModel>(spec.n, run);
+  else
+    detail::with_state_dim<PolynomialModel>(spec.n, run);
 }
 
 }  // namespace kushner

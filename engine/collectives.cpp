@@ -134,7 +134,7 @@ std::vector<double> broadcast(const std::vector<double>& value, int) { return va
 // ---- member shares -------------------------------------------------------------------------------------------
 
 MemberShare member_share(long members, int rank, int ranks) {
-  const long blocks = (members + moment_block_size - 1) / moment_block_size;
+  const long blocks = moment_blocks(members);
   // Blocks floor(r blocks / ranks) .. floor((r + 1) blocks / ranks) - 1 for rank r: shares differ by one block at
   // most, and the last rank, which holds the last (short) block, is one of those with the extra block, so no two
   // shares differ by more than 256 members.

@@ -4,7 +4,6 @@
 // estimator beside the bank. Like the particle filter it starts from the filters' prior.
 #include "engine/reference_estimator.hpp"
 #include "kernels/reference/exact_reference.hpp"
-#include "models/model_traits.hpp"
 
 #include <type_traits>
 
@@ -19,16 +18,10 @@ constexpr bool has_exact_reference = !std::is_void_v<exact_reference_t<Kokkos::D
 /// discrete time, a prior) its grid filter cannot take.
 template <class Model>
 const char* exact_filter_unsupported(const Model& model) {
-  if constexpr (!has_exact_reference<Model>) {
+  if constexpr (!has_exact_reference<Model>)
     return "no exact filter, and no grid filter above dimension 2";
-  } else if constexpr (std::is_same_v<exact_reference_t<Kokkos::DefaultHostExecutionSpace, Model>,
-                                      DiscreteGaussianGridFilter<Kokkos::DefaultHostExecutionSpace, Model>>) {
-    return DiscreteGaussianGridFilter<Kokkos::DefaultHostExecutionSpace, Model>::unsupported(model);
-  } else {
-    if constexpr (ModelTraits<Model>::runtime_checked)
-      if (!model.model_facts().axis_aligned_noise) return "the grid filter needs axis-aligned noise (b b^T diagonal)";
-    return nullptr;
-  }
+  else
+    return exact_reference_t<Kokkos::DefaultHostExecutionSpace, Model>::unsupported(model);
 }
 
 template <class ExecSpace, class Model>

@@ -82,6 +82,11 @@ KOKKOS_INLINE_FUNCTION BlockStatistic block_statistic(const Value& value, const 
 template <class MemSpace>
 using BlockStatistics = Kokkos::View<double**, Kokkos::LayoutRight, MemSpace>;
 
+/// Blocks of moment_block_size members that `members` members fill (the last may be short).
+KOKKOS_INLINE_FUNCTION constexpr long moment_blocks(const long members) {
+  return (members + moment_block_size - 1) / moment_block_size;
+}
+
 KOKKOS_INLINE_FUNCTION int block_end(const int b, const int members) {
   return b * moment_block_size + moment_block_size < members ? b * moment_block_size + moment_block_size : members;
 }
@@ -196,7 +201,7 @@ EnsembleMoments ensemble_moments(const ExecSpace& space, const View& x) {
   using MemSpace = typename View::memory_space;
   const int members = static_cast<int>(x.extent(0));
   const int columns = static_cast<int>(x.extent(1));
-  const int num_blocks = (members + moment_block_size - 1) / moment_block_size;
+  const int num_blocks = static_cast<int>(moment_blocks(members));
   // Allocated on `space`, not on the default execution space: with a few members on Serial, an OpenMP fork and
   // join per call cost more than the moments (kushner reproduce's one-member runs).
   BlockStatistics<MemSpace> blocks(Kokkos::view_alloc(space, Kokkos::WithoutInitializing, "kushner::moment_blocks"),
@@ -235,7 +240,7 @@ class ColumnMoments {
     const int num_columns = static_cast<int>(columns.size());
     if (num_columns == 0) return {};
     const int members = static_cast<int>(columns.front().extent(0));
-    const int num_blocks = (members + moment_block_size - 1) / moment_block_size;
+    const int num_blocks = static_cast<int>(moment_blocks(members));
     std::vector<std::uintptr_t> addresses;
     for (int c = 0; c < num_columns; ++c) {
       KUSHNER_REQUIRE(static_cast<int>(columns[c].extent(0)) == members && columns[c].span_is_contiguous(),
@@ -244,18 +249,18 @@ class ColumnMoments {
     }
     const auto& pointers = columns_.update(space, addresses);
     if (blocks_.extent(0) != static_cast<std::size_t>(num_blocks) ||
-        blocks_.extent(1) != static_cast<std::size_t>(3 * num_columns))
+        blocks_.extent(1) != static_cast<std::size_t>(3 * num_columns)) {
       blocks_ =
           BlockStatistics<MemSpace>(Kokkos::view_alloc(space, Kokkos::WithoutInitializing, "kushner::moment_blocks"),
                                     num_blocks, 3 * num_columns);
+      // The blocks themselves in host memory; a page-locked copy of them on a GPU.
+      rows_ = Kokkos::create_mirror_view(typename HostStaging<MemSpace>::space(), blocks_);
+    }
     Kokkos::parallel_for("kushner::block_column_moments",
                          Kokkos::RangePolicy<ExecSpace>(space, 0, num_blocks * num_columns),
                          BlockColumnMoments<MemSpace>{pointers, members, blocks_});
     space.fence();
-    if (rows_.extent(0) != blocks_.extent(0) || rows_.extent(1) != blocks_.extent(1))
-      rows_ = HostRows(Kokkos::view_alloc(Kokkos::WithoutInitializing, "kushner::moment_rows"), blocks_.extent(0),
-                       blocks_.extent(1));
-    Kokkos::deep_copy(rows_, blocks_);
+    if (rows_.data() != blocks_.data()) Kokkos::deep_copy(rows_, blocks_);
     return merge_block_statistics(rows_.data(), rows_.size(), num_columns, members);
   }
 
@@ -263,7 +268,7 @@ class ColumnMoments {
   using HostRows = Kokkos::View<double**, Kokkos::LayoutRight, typename HostStaging<MemSpace>::space>;
   DeviceAddresses<MemSpace> columns_;
   BlockStatistics<MemSpace> blocks_;
-  HostRows rows_;  // blocks_, copied
+  HostRows rows_;  // blocks_ (on the host) or its page-locked copy
 };
 
 }  // namespace kushner

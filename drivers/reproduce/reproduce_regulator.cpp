@@ -189,7 +189,6 @@ ExampleResult reproduce_regulator(const RegulatorCase& c, const ReproduceSetting
   const Outcome eq11 = printed(Poly3Reading::printed_car_eq11);
 
   const char* lin_eq = c.enotes ? "(12)" : "(24)";
-  const char* poly_eq = c.enotes ? "(11)" : "(23)";
   const std::string halves = " J is ours (no 1/2: twice Basin's stated cost), the units of the paper's table";
   const std::string readings[] = {
       std::string("Basin's linear regulator ") + lin_eq +

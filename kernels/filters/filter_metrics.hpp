@@ -108,18 +108,18 @@ class DivergedCounts {
       addresses.push_back(reinterpret_cast<std::uintptr_t>(s.data()));
     }
     const int members = static_cast<int>(truth_status.extent(0));
-    const int num_blocks = (members + moment_block_size - 1) / moment_block_size;
+    const int num_blocks = static_cast<int>(moment_blocks(members));
     const int columns = static_cast<int>(statuses.size());
     if (counts_.extent(0) != static_cast<std::size_t>(num_blocks) || counts_.extent(1) != statuses.size()) {
       counts_ = decltype(counts_)(Kokkos::view_alloc(space, Kokkos::WithoutInitializing, "kushner::diverged_counts"),
                                   num_blocks, columns);
-      host_ = HostCounts(Kokkos::view_alloc(Kokkos::WithoutInitializing, "kushner::diverged_counts_host"), num_blocks,
-                         columns);
+      // The counts themselves in host memory; a page-locked copy of them on a GPU.
+      host_ = Kokkos::create_mirror_view(typename HostStaging<MemSpace>::space(), counts_);
     }
     Kokkos::parallel_for("kushner::diverged_counts", Kokkos::RangePolicy<ExecSpace>(space, 0, num_blocks * columns),
                          BlockNotOkCounts<MemSpace>{columns_.update(space, addresses), truth_status, counts_});
     space.fence();
-    Kokkos::deep_copy(host_, counts_);
+    if (host_.data() != counts_.data()) Kokkos::deep_copy(host_, counts_);
     for (int b = 0; b < num_blocks; ++b)
       for (int s = 0; s < columns; ++s) totals[s] += host_(b, s);
     for (auto& t : totals) t = collective::sum(t);  // every rank, the same calls in the same order

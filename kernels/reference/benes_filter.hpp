@@ -119,6 +119,9 @@ class BenesFilter {
   using MemSpace = typename ExecSpace::memory_space;
 
   static double bytes_per_member() { return sizeof(double) * (2 + 3 + 1 + 1) + sizeof(Status); }
+  /// Why it cannot run `model` (kernels/reference/exact_reference.hpp): nullptr; a degenerate prior variance is
+  /// refused where the filter is made, with its value.
+  static const char* unsupported(const BenesModel&) { return nullptr; }
 
   BenesFilter(const ExecSpace& space, const BenesModel& model, int num_members, bool truth_law = false)
       : space_(space),

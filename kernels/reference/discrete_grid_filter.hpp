@@ -109,6 +109,8 @@ class DiscreteGridFilter {
   using MemSpace = typename ExecSpace::memory_space;
   static_assert(Model::discrete_time && Model::state_dim == 1, "DiscreteGridFilter: scalar discrete-time models");
   static constexpr int default_cells = 400;
+  /// Why it cannot run `model` (kernels/reference/exact_reference.hpp): every scalar bounded-noise model.
+  static const char* unsupported(const Model&) { return nullptr; }
   /// Bytes allocated per member: the masses (two copies), the grid, the posterior.
   static double bytes_per_member(int cells = default_cells) {
     return sizeof(double) * (2.0 * cells + 4) + sizeof(Status);

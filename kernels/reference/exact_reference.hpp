@@ -39,7 +39,8 @@ struct exact_reference<ExecSpace, BenesModel> {
 };
 
 /// The reference type for Model, or void; every one has step(k, dt, dy), posterior_mean() (member, i),
-/// posterior_covariance() (member, packed) and status().
+/// posterior_covariance() (member, packed), status(), and a static unsupported(model): why it cannot run that
+/// model's values (nullptr: it can).
 template <class ExecSpace, class Model>
 using exact_reference_t = typename exact_reference<ExecSpace, Model>::type;
 

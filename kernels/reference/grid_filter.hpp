@@ -22,6 +22,7 @@
 #include "core/status.hpp"
 #include "kernels/bank.hpp"
 #include "kernels/for_each_member.hpp"
+#include "models/model_traits.hpp"
 
 #include <Kokkos_Core.hpp>
 
@@ -219,6 +220,13 @@ class GridFilter {
 
   static int points_per_axis(const GridOptions& options) {
     return options.points_per_axis > 0 ? options.points_per_axis : (D == 1 ? 256 : 128);
+  }
+  /// Why it cannot run `model` (kernels/reference/exact_reference.hpp): a model file whose noise is not
+  /// axis-aligned (a built-in model's is, or it has no grid filter); the constructor checks b b^T at the mean.
+  static const char* unsupported(const Model& model) {
+    if constexpr (ModelTraits<Model>::runtime_checked)
+      if (!model.model_facts().axis_aligned_noise) return "the grid filter needs axis-aligned noise (b b^T diagonal)";
+    return nullptr;
   }
   /// Bytes allocated per member: the masses (two copies) and the grid's and posterior's numbers.
   static double bytes_per_member(const GridOptions& options = {}) {

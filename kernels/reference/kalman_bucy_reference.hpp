@@ -65,6 +65,9 @@ class KalmanBucyReference {
   using MemSpace = typename ExecSpace::memory_space;
 
   static double bytes_per_member() { return sizeof(double) * (N + packed_size(N)) + sizeof(Status); }
+  /// Why it cannot run `model` (every reference answers this, kernels/reference/exact_reference.hpp): it runs
+  /// every linear model.
+  static const char* unsupported(const LinearModel<N>&) { return nullptr; }
 
   /// Starts every member at N(prior_mean, prior_cov) (or the truths' law when `truth_law`).
   KalmanBucyReference(const ExecSpace& space, const LinearModel<N>& model, int num_members, bool truth_law = false)
