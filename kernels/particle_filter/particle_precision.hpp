@@ -7,10 +7,10 @@ namespace kushner {
 
 /// fp64: every number in double. mixed: particles, weights and every sum in double, the normals of the particles'
 /// noise and initial states drawn in float from the same Philox blocks (kernels/rng.hpp): a GPU's fp32 log, sqrt
-/// and sincospi cost a fraction of the fp64 ones, and the step's Box-Muller was most of its instructions
-/// (perf/particle_filter.md). The normals agree with fp64's to about 1e-7 and are cut at 5.77 standard deviations
-/// of the radius (probability 2^-24 beyond); tests/test_particle_filter_references.cpp checks both for bias
-/// against exact filters.
+/// and sincospi cost a fraction of the fp64 ones (H200: 1.10x the fp64 step, 1.21x with step_pair; the step is
+/// bound by the card's power cap: perf/particle_filter.md). The normals agree with fp64's to about 1e-7 and are cut
+/// at 5.77 standard deviations of the radius (probability 2^-24 beyond); tests/test_particle_filter_references.cpp
+/// checks both precisions for bias against exact filters.
 enum class ParticlePrecision { fp64, mixed };
 
 inline const char* to_string(ParticlePrecision p) {
