@@ -98,6 +98,14 @@ KOKKOS_INLINE_FUNCTION void uniform_pair(const RngKey& key, const Counter& c, do
   u1 = uniform_open(r.v[2], r.v[3]);
 }
 
+/// Two independent fp32 uniforms in (0, 1) from one Philox block: uniform_open_fp32 of its high words (the
+/// `mixed` precision's; simd::uniform_pair_fp32 gives the same floats).
+KOKKOS_INLINE_FUNCTION void uniform_pair_fp32(const RngKey& key, const Counter& c, float& u0, float& u1) {
+  const r123array4x32 r = philox_block(key, c);
+  u0 = uniform_open_fp32(r.v[0]);
+  u1 = uniform_open_fp32(r.v[2]);
+}
+
 struct NormalPair {
   double z0, z1;
 };

@@ -21,9 +21,7 @@ struct Random123Draws {
     uniform_pair(key, c, u0, u1);
   }
   KOKKOS_INLINE_FUNCTION static void uniforms_fp32(const RngKey& key, const Counter& c, float& u0, float& u1) {
-    const r123array4x32 r = philox_block(key, c);
-    u0 = uniform_open_fp32(r.v[0]);
-    u1 = uniform_open_fp32(r.v[2]);
+    uniform_pair_fp32(key, c, u0, u1);
   }
 };
 

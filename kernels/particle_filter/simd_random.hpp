@@ -58,7 +58,7 @@ KOKKOS_INLINE_FUNCTION void uniform_pair(const RngKey& key, const Counter& c, do
   u1 = uniform_open(r[2], r[3]);
 }
 
-/// The fp32 uniforms of the same block (kushner::uniform_open_fp32 of its high words).
+/// kushner::uniform_pair_fp32, the same floats (uniform_open_fp32 of the block's high words).
 KOKKOS_INLINE_FUNCTION void uniform_pair_fp32(const RngKey& key, const Counter& c, float& u0, float& u1) {
   std::uint64_t r[4];
   philox4x32_10(c.member + key.seed.first_member, c.particle, c.step, c.draw, key.seed.value,
