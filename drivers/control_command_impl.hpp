@@ -230,6 +230,9 @@ nlohmann::json run_controlled_model(const Model& model, const ControlOptions& op
     KUSHNER_INPUT_REQUIRE(hjb_solvable<Model>(),
                           "--reference hjb: model '" << Model::name << "' is not of dimension 1-2 with one control");
   const ParticleSettings particle = particle_settings(options);
+  KUSHNER_INPUT_REQUIRE(particle.step_pairs != StepPairs::always,
+                        "--step-pairs always: a closed loop's particle filter takes one step at a time (each control "
+                        "needs the step before)");
   KUSHNER_INPUT_REQUIRE(
       options.trace_member >= 0 && options.trace_member < options.run.members,
       "--trace-member: member " << options.trace_member << " is not in 0 .. " << options.run.members - 1);

@@ -77,6 +77,17 @@ inline nlohmann::json filter_summary(const FilterReport& report) {
 struct RunMemory {
   double bank_bytes_per_member = 0.0, particle_bytes_per_particle = 0.0, total_bytes = 0.0;
 };
+/// Whether the particle filter of `particle` fuses its step pairs on the selected backend.
+template <class Model>
+bool particle_fuses_step_pairs(const ParticleSettings& particle) {
+  bool fuses = false;
+  with_backend(selected_backend(), [&](const auto& space) {
+    using ExecSpace = std::decay_t<decltype(space)>;
+    fuses = ParticleFilterBank<ExecSpace, Model>::fuses_step_pairs(particle.options, particle.particles);
+  });
+  return fuses;
+}
+
 template <class Model>
 RunMemory run_memory(const CompareOptions& options, const std::vector<std::string>& filters,
                      const OptionValues& settings, const ParticleSettings& particle) {
@@ -89,12 +100,33 @@ RunMemory run_memory(const CompareOptions& options, const std::vector<std::strin
     if (std::find(filters.begin(), filters.end(), exact_filter_name) != filters.end())
       memory.bank_bytes_per_member +=
           ExactReferenceEstimator<Kokkos::DefaultHostExecutionSpace, Model>::bytes_per_member();
+  const bool particle_filter = std::find(filters.begin(), filters.end(), particle_filter_name) != filters.end();
+  const bool fuses = particle_filter && particle_fuses_step_pairs<Model>(particle);
+  const bool pairs = particle_filter && (particle.step_pairs == StepPairs::always ||
+                                         (particle.step_pairs == StepPairs::automatic && fuses));
+  if (pairs) memory.bank_bytes_per_member += Bank::step_pair_bytes_per_member(static_cast<long>(filters.size()));
   memory.total_bytes = static_cast<double>(options.run.members) * memory.bank_bytes_per_member;
-  if (std::find(filters.begin(), filters.end(), particle_filter_name) != filters.end()) {
+  if (particle_filter) {
     memory.particle_bytes_per_particle = Particles::bytes_per_particle(particle.options);
     memory.total_bytes += Particles::bytes_needed(options.run.members, particle.particles, particle.options);
   }
+  if (pairs && fuses) {
+    memory.particle_bytes_per_particle += (Model::state_dim + 1.0) * sizeof(double);  // the second bank
+    memory.total_bytes += Particles::step_pair_bytes_needed(options.run.members, particle.particles);
+  }
   return memory;
+}
+
+/// The run's particle settings: the options', with step pairs off where `auto` would fuse them but the second
+/// particle bank does not fit (the run then needs what it needed before pairs existed).
+template <class Model>
+ParticleSettings run_particle_settings(const CompareOptions& options, const std::vector<std::string>& filters,
+                                       const OptionValues& settings) {
+  ParticleSettings particle = particle_settings(options);
+  if (particle.step_pairs == StepPairs::automatic &&
+      !memory_fits(run_memory<Model>(options, filters, settings, particle).total_bytes, selected_backend()))
+    particle.step_pairs = StepPairs::never;
+  return particle;
 }
 
 inline nlohmann::json memory_json(const RunMemory& memory) {
@@ -117,7 +149,7 @@ std::vector<std::string> check_compare_options(const Model& model, const Compare
         std::find(filters.begin(), filters.end(), exact_filter_name) != filters.end())
       check_covariance("filter EXACT (grid filter): prior_cov", model.prior_cov, /*allow_singular=*/false);
   }
-  const ParticleSettings particle = particle_settings(options);
+  const ParticleSettings particle = detail::run_particle_settings<Model>(options, filters, settings);
   if (std::find(filters.begin(), filters.end(), particle_filter_name) != filters.end()) {
     // The particle kernels index (particle block, member) and their teams with int.
     const long long items = static_cast<long long>(options.run.members) * particle.particles;
@@ -202,7 +234,7 @@ nlohmann::json run_compare_with_truth(const TruthModel& truth_model, const Model
                                       const OutputDirectory& out, const MakeExtras& make_extras = {},
                                       const Checkpoint* resume = nullptr) {
   const std::vector<std::string> filters = check_compare_options<Model>(model, options, settings);
-  const ParticleSettings particle = particle_settings(options);
+  const ParticleSettings particle = detail::run_particle_settings<Model>(options, filters, settings);
   std::vector<double> density_times = options.density_times;
   if (density_times.empty() && options.plots) density_times = {0.1 * options.run.T, 0.5 * options.run.T, options.run.T};
   nlohmann::json summary;

@@ -61,6 +61,11 @@ void add_filter_options(CLI::App& app, FilterOptions& o) {
                  "PF arithmetic: fp64, or mixed (normals drawn in fp32, state, weights and sums in fp64; faster on "
                  "GPUs)")
       ->capture_default_str();
+  app.add_option("--step-pairs", o.step_pairs,
+                 "PF takes two steps per pass over its particles, the bank scoring one step behind: auto (where its "
+                 "kernel fuses them, i.e. on GPUs with systematic resampling, and the second particle bank fits in "
+                 "memory), never, or always (elsewhere the two steps one after the other: the same numbers as never)")
+      ->capture_default_str();
   app.add_option_function<double>(
       "--checkpoint-every",
       [&o](double seconds) {
@@ -104,6 +109,11 @@ ParticleSettings particle_settings(const FilterOptions& o) {
   KUSHNER_INPUT_REQUIRE(precision.has_value(),
                         "--precision: unknown precision '" << o.precision << "' (known: fp64, mixed)");
   settings.options.precision = *precision;
+  KUSHNER_INPUT_REQUIRE(o.step_pairs == "auto" || o.step_pairs == "always" || o.step_pairs == "never",
+                        "--step-pairs: unknown value '" << o.step_pairs << "' (known: auto, always, never)");
+  settings.step_pairs = o.step_pairs == "auto"     ? StepPairs::automatic
+                        : o.step_pairs == "always" ? StepPairs::always
+                                                   : StepPairs::never;
   return settings;
 }
 

@@ -23,6 +23,7 @@ struct FilterOptions {
   std::string resample = "systematic";
   double ess_threshold = ParticleFilterOptions{}.ess_threshold;
   std::string precision = to_string(ParticleFilterOptions{}.precision);
+  std::string step_pairs = "auto";
   /// --checkpoint-every SECONDS: save the run's state into --out this often (`kushner resume`); < 0: not given.
   double checkpoint_every = -1.0;
   bool checkpoint_every_given = false;

@@ -14,4 +14,7 @@ std::string format_bytes(double bytes);
 void require_memory_fits(double bytes, const std::string& sizes, const std::string& breakdown,
                          const std::string& backend);
 
+/// Whether require_memory_fits would pass.
+bool memory_fits(double bytes, const std::string& backend);
+
 }  // namespace kushner

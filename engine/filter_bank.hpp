@@ -3,8 +3,10 @@
 // filter the model supports as a slot (kernels/filters/filter_slot.hpp) with the selected ones allocated and
 // enabled, the fused step kernel, and the reductions behind the reported metrics. Estimators outside the bank
 // (particle filter, exact filters: engine/reference_estimator.hpp) step on the same dy right after it and are
-// scored like filters; one of them may be the reference that every other estimate is measured against. Reductions go
-// through ensemble_moments (fixed-order blocks), so every number is the same on any number of threads.
+// scored like filters; one of them may be the reference that every other estimate is measured against. Where the
+// reference takes two steps in one pass (the particle filter on a GPU), step_pair takes two bank steps and scores
+// the first one behind. Reductions go through ensemble_moments (fixed-order blocks), so every number is the same
+// on any number of threads.
 #include "engine/reference_estimator.hpp"
 #include "engine/truth_bank.hpp"
 #include "kernels/ensemble_moments.hpp"
@@ -157,7 +159,7 @@ class FilterBank {
   /// add_estimator). The bank steps it after each of its own steps (once, also when it is an estimator).
   void set_reference(ReferenceEstimator<MemSpace>* reference) {
     reference_ = reference;
-    if (reference_) score_reference(true);
+    if (reference_) score_reference(slots_, now(), true);
   }
 
   /// Steps `estimator` after every bank step and scores it like a filter, named estimator->name() (call
@@ -171,24 +173,52 @@ class FilterBank {
     e.slot.score = BankVector<MemSpace>("kushner::score_" + e.name, members_, num_score_columns);
     e.slot.snapshot = BankVector<MemSpace>("kushner::snapshot_" + e.name, members_, num_snapshot_columns);
     estimators_.push_back(e);
-    score_estimator(estimators_.back(), true);
+    score_estimator(estimators_.back(), estimator->estimate(), now(), true);
   }
 
   /// Step k, over [k dt, (k + 1) dt]; `record`: (k + 1) dt is an output time.
   void step(long k, double dt, bool record) {
-    const auto step = static_cast<std::uint32_t>(k);
-    typename K::Step kernel{
-        TruthStep<TruthModel, MemSpace>{truth_model_, truths_.state(), truths_.observations(), k * dt, dt, seed_, step},
-        filter_model_, truth_status_, slots_, record};
-    parallel_for_members("kushner::filter_bank_step", space_, members_, kernel);
+    run_step_kernel(k, dt, record);
     bool reference_stepped = false;
     for (auto& e : estimators_) {
       e.estimator->advance(k, k * dt, dt, truths_.observations());
       reference_stepped = reference_stepped || e.estimator == reference_;
     }
     if (reference_ && !reference_stepped) reference_->advance(k, k * dt, dt, truths_.observations());
-    if (reference_) score_reference(record);
-    for (auto& e : estimators_) score_estimator(e, record);
+    score_now(record);
+  }
+
+  /// Whether a run should call step_pair: the reference advances in pairs (ReferenceEstimator::advances_in_pairs).
+  bool steps_in_pairs() const { return reference_ != nullptr && reference_->advances_in_pairs(); }
+
+  /// Steps k and k + 1 (`record`: (k + 2) dt is an output time; (k + 1) dt must not be one), the reference
+  /// taking both in one advance_pair. Step k's scores against the reference and the outside estimators' scores
+  /// wait for it: what they read of step k (the truths, their statuses and dy, each filter's m and status) is
+  /// kept before the bank takes step k + 1. Every score gets the same terms in the same order as step(k, dt,
+  /// false) then step(k + 1, dt, record), so the numbers are those of the two steps wherever the reference's pair
+  /// is (ParticleFilterBank::step_pair).
+  void step_pair(long k, double dt, bool record) {
+    KUSHNER_REQUIRE(steps_in_pairs(), "step_pair: the reference does not advance in pairs");
+    run_step_kernel(k, dt, false);
+    keep_step();
+    run_step_kernel(k + 1, dt, record);
+    reference_->advance_pair(k, k * dt, dt, kept_.dy, truths_.observations());
+    const EstimateViews<MemSpace> reference_then = reference_->first_of_pair();
+    const ScoredTime then{kept_.truth, kept_.truth_status, reference_then.mean, reference_then.status};
+    for (auto& e : estimators_)
+      if (e.estimator != reference_) e.estimator->advance(k, k * dt, dt, kept_.dy);
+    score_reference(kept_.slots, then, false);
+    for (auto& e : estimators_)
+      score_estimator(e, e.estimator == reference_ ? reference_then : e.estimator->estimate(), then, false);
+    for (auto& e : estimators_)
+      if (e.estimator != reference_) e.estimator->advance(k + 1, (k + 1) * dt, dt, truths_.observations());
+    score_now(record);
+  }
+
+  /// Bytes step_pair keeps per member for `filters` filters: a step's truth, dy and statuses, each filter's m.
+  static double step_pair_bytes_per_member(long filters) {
+    return sizeof(double) * (n + p) + sizeof(Status) +
+           static_cast<double>(filters) * (sizeof(double) * n + sizeof(Status));
   }
 
   const TruthBank<ExecSpace, TruthModel>& truths() const { return truths_; }
@@ -363,27 +393,95 @@ class FilterBank {
     FilterSlot<ExternalEstimator, MemSpace> slot;  // m, P, status: the estimator's views
   };
 
+  /// What the scores of one time read besides the estimates: the truths and their statuses, the reference's mean
+  /// and status (empty without a reference).
+  struct ScoredTime {
+    BankVector<MemSpace> truth;
+    BankScalar<Status, MemSpace> truth_status;
+    BankVector<MemSpace> reference;
+    BankScalar<Status, MemSpace> reference_status;
+  };
+  ScoredTime now() const {
+    if (!reference_) return {truths_.state(), truth_status_, {}, {}};
+    return {truths_.state(), truth_status_, reference_->mean(), reference_->status()};
+  }
+
+  /// step_pair's copy of step k: truths, statuses, dy, and slots whose m and status are copies of step k's (their
+  /// scores, snapshots and filters are the bank's own).
+  struct KeptStep {
+    BankVector<MemSpace> truth, dy;
+    BankScalar<Status, MemSpace> truth_status;
+    typename K::Slots slots;
+  };
+
+  void keep_step() {
+    if (kept_.truth.extent(0) == 0) {
+      kept_.truth = BankVector<MemSpace>("kushner::truth_kept", members_, n);
+      kept_.dy = BankVector<MemSpace>("kushner::dy_kept", members_, p);
+      kept_.truth_status = BankScalar<Status, MemSpace>("kushner::truth_status_kept", members_);
+      kept_.slots = slots_;
+      for_each_kept_slot([&](auto& kept, const auto& slot) {
+        if (!slot.enabled) return;
+        const std::string name = decltype(slot.filter)::name;
+        kept.m = BankVector<MemSpace>("kushner::m_kept_" + name, members_, n);
+        kept.status = BankScalar<Status, MemSpace>("kushner::status_kept_" + name, members_);
+      });
+    }
+    Kokkos::deep_copy(space_, kept_.truth, truths_.state());
+    Kokkos::deep_copy(space_, kept_.dy, truths_.observations());
+    Kokkos::deep_copy(space_, kept_.truth_status, truth_status_);
+    for_each_kept_slot([&](auto& kept, const auto& slot) {
+      if (!slot.enabled) return;
+      Kokkos::deep_copy(space_, kept.m, slot.m);
+      Kokkos::deep_copy(space_, kept.status, slot.status);
+    });
+  }
+  template <class F>
+  void for_each_kept_slot(F&& f) {
+    for_each_kept_slot_impl(f, static_cast<SupportedFilters<Model, MemSpace>*>(nullptr));
+  }
+  template <class F, class... Filters>
+  void for_each_kept_slot_impl(F& f, std::tuple<Filters...>*) {
+    (f(static_cast<FilterSlot<Filters, MemSpace>&>(kept_.slots),
+       static_cast<const FilterSlot<Filters, MemSpace>&>(slots_)),
+     ...);
+  }
+
   bool scored_against_reference(const std::string& name) const {
     return reference_ != nullptr && name != reference_->name();
   }
 
-  void score_estimator(Estimator& e, bool record) {
-    e.slot.m = e.estimator->mean();
-    e.slot.P = e.estimator->covariance();
-    e.slot.status = e.estimator->status();
-    const bool against_reference = scored_against_reference(e.name);
-    const BankVector<MemSpace> reference = against_reference ? reference_->mean() : BankVector<MemSpace>();
-    const BankScalar<Status, MemSpace> reference_status =
-        against_reference ? reference_->status() : BankScalar<Status, MemSpace>();
-    parallel_for_members(
-        "kushner::estimator_score", space_, members_,
-        EstimatorScore<n, MemSpace>{e.slot, truths_.state(), reference, reference_status, truth_status_, record});
+  void run_step_kernel(long k, double dt, bool record) {
+    const auto step = static_cast<std::uint32_t>(k);
+    typename K::Step kernel{
+        TruthStep<TruthModel, MemSpace>{truth_model_, truths_.state(), truths_.observations(), k * dt, dt, seed_, step},
+        filter_model_, truth_status_, slots_, record};
+    parallel_for_members("kushner::filter_bank_step", space_, members_, kernel);
   }
 
-  void score_reference(bool record) {
+  /// Scores every filter against the reference, and every outside estimator, at the time the bank is at.
+  void score_now(bool record) {
+    const ScoredTime time = now();
+    if (reference_) score_reference(slots_, time, record);
+    for (auto& e : estimators_) score_estimator(e, e.estimator->estimate(), time, record);
+  }
+
+  void score_estimator(Estimator& e, const EstimateViews<MemSpace>& estimate, const ScoredTime& time, bool record) {
+    e.slot.m = estimate.mean;
+    e.slot.P = estimate.covariance;
+    e.slot.status = estimate.status;
+    const bool against_reference = scored_against_reference(e.name);
+    parallel_for_members(
+        "kushner::estimator_score", space_, members_,
+        EstimatorScore<n, MemSpace>{e.slot, time.truth, against_reference ? time.reference : BankVector<MemSpace>(),
+                                    against_reference ? time.reference_status : BankScalar<Status, MemSpace>(),
+                                    time.truth_status, record});
+  }
+
+  void score_reference(const typename K::Slots& slots, const ScoredTime& time, bool record) {
     parallel_for_members(
         "kushner::filter_bank_reference_score", space_, members_,
-        typename K::Reference{reference_->mean(), reference_->status(), truth_status_, slots_, record});
+        typename K::Reference{time.reference, time.reference_status, time.truth_status, slots, record});
   }
 
   template <class View>
@@ -419,6 +517,7 @@ class FilterBank {
   typename K::Slots slots_;
   ReferenceEstimator<MemSpace>* reference_ = nullptr;
   std::vector<Estimator> estimators_;
+  KeptStep kept_;
   mutable ColumnMoments<ExecSpace> snapshot_moments_;  // buffers kept from one output step to the next
   mutable DivergedCounts<ExecSpace> diverged_counts_;
 };

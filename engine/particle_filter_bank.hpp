@@ -88,8 +88,7 @@ class ParticleFilterBank {
     KUSHNER_REQUIRE(num_particles >= 1, "particles: " << num_particles);
     KUSHNER_REQUIRE(options.ess_threshold >= 0.0 && options.ess_threshold <= 1.0,
                     "ess_threshold: " << options.ess_threshold);
-    use_team_ = options.kernel == ParticleKernel::team ||
-                (options.kernel == ParticleKernel::automatic && !std::is_same<MemSpace, Kokkos::HostSpace>::value);
+    use_team_ = uses_team_kernel(options);
     constexpr bool host_memory = std::is_same<MemSpace, Kokkos::HostSpace>::value;
     KUSHNER_REQUIRE(use_team_ || host_memory, "the host block kernel needs host memory");
     team_size_ = options.team_size > 0 ? options.team_size : (host_memory ? 1 : device_particle_team);
@@ -106,8 +105,7 @@ class ParticleFilterBank {
     x_scratch_ = ParticleBank<MemSpace>("kushner::particles_scratch", num_particles, num_members, n);
     workspace_.cumulative = decltype(workspace_.cumulative)("kushner::log_weights", num_particles, num_members);
     workspace_.ancestors = decltype(workspace_.ancestors)("kushner::ancestors", num_particles, num_members);
-    use_chunked_resample_ =
-        use_team_ && options.scheme == ResamplingScheme::systematic && chunked_resample_supports(num_particles);
+    use_chunked_resample_ = fuses_step_pairs(options, num_particles);
     if (use_chunked_resample_) {
       resample_list_ = Kokkos::View<int*, MemSpace>("kushner::resample_list", num_members);
       resample_list_size_ = Kokkos::View<int, MemSpace>("kushner::resample_list_size");
@@ -154,7 +152,7 @@ class ParticleFilterBank {
   /// Bytes the bank allocates for `members` members of `particles` particles: per particle its state and the
   /// resampling scratch copy, its log-weight and ancestor index (and offspring count for residual resampling);
   /// per member the block partials (at the smallest block, the host's), the scan's block sums and the
-  /// posterior. step_pair's second bank is not counted (the command line does not use it).
+  /// posterior. step_pair's second bank is step_pair_bytes_needed.
   static double bytes_needed(long members, long particles, const ParticleFilterOptions& options) {
     return static_cast<double>(members) *
            (bytes_per_particle(options) * static_cast<double>(particles) + bytes_per_member(particles));
@@ -168,6 +166,23 @@ class ParticleFilterBank {
     return sizeof(double) * (blocks * WeightedMoments<state_dim>::size + scan_num_blocks(static_cast<int>(particles)) +
                              2.0 + 2.0 * state_dim + packed_size(state_dim)) +
            3.0 * sizeof(int) + sizeof(Status);
+  }
+
+  /// Bytes step_pair allocates besides bytes_needed when it fuses its steps: a second bank of states and
+  /// log-weights, the second step's block partials (at the host's block, an upper bound) and step k's posterior.
+  static double step_pair_bytes_needed(long members, long particles) {
+    const double blocks = static_cast<double>((particles + host_particle_block - 1) / host_particle_block);
+    return static_cast<double>(members) *
+           (sizeof(double) * ((state_dim + 1.0) * static_cast<double>(particles) +
+                              blocks * WeightedMoments<state_dim>::size + 2.0 + state_dim + packed_size(state_dim)) +
+            sizeof(Status));
+  }
+
+  /// Whether a bank with `options` and `particles` particles per member fuses step_pair's two steps (the team
+  /// kernel with chunked systematic resampling).
+  static bool fuses_step_pairs(const ParticleFilterOptions& options, int particles) {
+    return uses_team_kernel(options) && options.scheme == ResamplingScheme::systematic &&
+           chunked_resample_supports(particles);
   }
 
   /// Steps k and k + 1 (increments dy, then dy_next): the same results as step(k) then step(k + 1), apart
@@ -185,6 +200,7 @@ class ParticleFilterBank {
       Kokkos::deep_copy(space_, first_.mean, mean_);
       Kokkos::deep_copy(space_, first_.covariance, covariance_);
       Kokkos::deep_copy(space_, first_.ess, ess_);
+      Kokkos::deep_copy(space_, first_.status, status_);
       step(k + 1, dt, dy_next);
       return;
     }
@@ -207,6 +223,7 @@ class ParticleFilterBank {
     // were taken relative to them.
     Kokkos::deep_copy(space_, resample_list_size_, 0);
     run_posterior(partials_, first_, first_log_normalizer_, false);
+    Kokkos::deep_copy(space_, first_.status, status_);
     // The members step k resamples: copy their step k - 1 particles back, step k, resample, step k + 1.
     const long copy_items = static_cast<long>(num_members_) * num_particles_;
     copy_listed_members<state_dim>(
@@ -226,11 +243,12 @@ class ParticleFilterBank {
   }
 
   /// The posterior after the first step of the last step_pair (allocated by the first step_pair): (member, i),
-  /// (member, packed), (member).
+  /// (member, packed), (member), and the members' status then.
   struct PosteriorViews {
     BankVector<MemSpace> mean;
     BankSymmetric<MemSpace> covariance;
     BankScalar<double, MemSpace> ess;
+    BankScalar<Status, MemSpace> status;
   };
   const PosteriorViews& first_step() const { return first_; }
   /// Whether step_pair takes its two steps in one pass over the particles (else it is two steps).
@@ -266,8 +284,8 @@ class ParticleFilterBank {
   const BankScalar<double, MemSpace>& log_normalizer() const { return log_normalizer_; }
 
   /// What a checkpoint holds: the particles, their log-weights and everything a step reads from the step
-  /// before. Scratch (the resampling copy, ancestors, partial sums) is rewritten by every step, and step_pair's
-  /// second bank is not used where runs are checkpointed (the command line).
+  /// before. Scratch (the resampling copy, ancestors, partial sums) is rewritten by every step, and so are
+  /// step_pair's second bank and first-step posterior (a checkpoint is taken between pairs).
   template <class Archive>
   void visit_state(Archive& archive) {
     archive.view("particles", x_);
@@ -283,6 +301,11 @@ class ParticleFilterBank {
   }
 
  private:
+  static bool uses_team_kernel(const ParticleFilterOptions& options) {
+    return options.kernel == ParticleKernel::team ||
+           (options.kernel == ParticleKernel::automatic && !std::is_same<MemSpace, Kokkos::HostSpace>::value);
+  }
+
   void require_increments_shape(const BankVector<MemSpace>& dy) const {
     KUSHNER_REQUIRE(dy.extent_int(0) == num_members_ && dy.extent_int(1) == Model::obs_dim,
                     "dy has shape (" << dy.extent(0) << ", " << dy.extent(1) << "), expected (" << num_members_ << ", "
@@ -368,7 +391,7 @@ class ParticleFilterBank {
                              options_.ess_threshold * num_particles_, resample_list_, resample_list_size_});
   }
 
-  PosteriorViews current_posterior() const { return {mean_, covariance_, ess_}; }
+  PosteriorViews current_posterior() const { return {mean_, covariance_, ess_, status_}; }
 
   /// Chunked systematic resampling of the listed members at `step`, from the log-weights less `log_normalizer`.
   void resample_listed(const BankScalar<double, MemSpace>& log_normalizer, std::uint32_t step) {
@@ -394,7 +417,8 @@ class ParticleFilterBank {
     if (first_.mean.extent(0) > 0) return;
     first_ = {BankVector<MemSpace>("kushner::particle_mean_first", num_members_, state_dim),
               BankSymmetric<MemSpace>("kushner::particle_covariance_first", num_members_, packed_size(state_dim)),
-              BankScalar<double, MemSpace>("kushner::ess_first", num_members_)};
+              BankScalar<double, MemSpace>("kushner::ess_first", num_members_),
+              BankScalar<Status, MemSpace>("kushner::particle_status_first", num_members_)};
     first_log_normalizer_ = BankScalar<double, MemSpace>("kushner::log_normalizer_first", num_members_);
   }
 

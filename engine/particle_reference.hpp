@@ -29,10 +29,17 @@ constexpr const char* particle_filter_unsupported() {
   return nullptr;
 }
 
+/// When the particle filter takes two steps per call (ParticleFilterBank::step_pair) and the bank scores one
+/// step behind for it: where its kernel fuses the two steps into one pass over the particles (the GPU's), always
+/// (the two steps one after the other where it does not fuse them: the same numbers as `never`, which tests
+/// check), or never.
+enum class StepPairs { automatic, always, never };
+
 /// Particle-filter settings of `kushner filter` and `kushner compare`.
 struct ParticleSettings {
   int particles = 1024;
   ParticleFilterOptions options;
+  StepPairs step_pairs = StepPairs::automatic;
 };
 
 template <int N, class MemSpace>
@@ -57,15 +64,24 @@ class ParticleReference final : public ReferenceEstimator<typename ExecSpace::me
                     const ParticleSettings& settings)
       : space_(space),
         pf_(space, model, static_cast<int>(members), settings.particles, seed, settings.options),
-        sums_("kushner::particle_reference_sums", members, 2) {}
+        sums_("kushner::particle_reference_sums", members, 2),
+        in_pairs_(settings.step_pairs == StepPairs::always ||
+                  (settings.step_pairs == StepPairs::automatic && pf_.fuses_step_pairs())) {}
 
   std::string name() const override { return particle_filter_name; }
   void advance(long k, double, double dt, const BankVector<MemSpace>& dy) override {
     pf_.step(k, dt, dy);
-    parallel_for_members(
-        "kushner::accumulate_ess", space_, pf_.num_members(),
-        AccumulateEss<Model::state_dim, MemSpace>{pf_.effective_sample_size(), pf_.posterior_covariance(), sums_});
-    ++steps_;
+    accumulate_ess(pf_.effective_sample_size(), pf_.posterior_covariance());
+  }
+  bool advances_in_pairs() const override { return in_pairs_; }
+  void advance_pair(long k, double, double dt, const BankVector<MemSpace>& dy,
+                    const BankVector<MemSpace>& dy_next) override {
+    pf_.step_pair(k, dt, dy, dy_next);
+    accumulate_ess(pf_.first_step().ess, pf_.first_step().covariance);
+    accumulate_ess(pf_.effective_sample_size(), pf_.posterior_covariance());
+  }
+  EstimateViews<MemSpace> first_of_pair() const override {
+    return {pf_.first_step().mean, pf_.first_step().covariance, pf_.first_step().status};
   }
   BankVector<MemSpace> mean() const override { return pf_.posterior_mean(); }
   BankSymmetric<MemSpace> covariance() const override { return pf_.posterior_covariance(); }
@@ -95,6 +111,7 @@ class ParticleReference final : public ReferenceEstimator<typename ExecSpace::me
             {"resampling", std::string(to_string(pf_.options().scheme))},
             {"ess_threshold", pf_.options().ess_threshold},
             {"precision", std::string(to_string(pf_.options().precision))},
+            {"step_pairs", in_pairs_ ? std::string(pf_.fuses_step_pairs() ? "fused" : "unfused") : std::string("off")},
             {"mean_ess", steps_ > 0 ? ess_total / member_steps : std::nan("")},
             {"noise_floor", steps_ > 0 ? std::sqrt(squared_error_total / member_steps) : std::nan("")},
             {"resamples", resample_total},
@@ -114,9 +131,16 @@ class ParticleReference final : public ReferenceEstimator<typename ExecSpace::me
   const ParticleFilterBank<ExecSpace, Model>& bank() const { return pf_; }
 
  private:
+  void accumulate_ess(const BankScalar<double, MemSpace>& ess, const BankSymmetric<MemSpace>& covariance) {
+    parallel_for_members("kushner::accumulate_ess", space_, pf_.num_members(),
+                         AccumulateEss<Model::state_dim, MemSpace>{ess, covariance, sums_});
+    ++steps_;
+  }
+
   ExecSpace space_;
   ParticleFilterBank<ExecSpace, Model> pf_;
   BankVector<MemSpace> sums_;
+  bool in_pairs_;
   long steps_ = 0;
 };
 

@@ -104,13 +104,19 @@ def main():
         report_other(out, f"jax_{dtype}", f"JAX {dtype}", "jax", target)
     print("-- the command line (kushner filter --model sine --filters PF, M = 1000, N = 65536, 1000 steps), same call")
     for precision, key in (("fp64", "step"), ("mixed", "step mixed")):
-        c = load(os.path.join(out, f"cli_{precision}.json"))
-        if c and "timing" in c:
-            rate = c["timing"]["particle_steps_per_s"]
-            versus = f", {rate / target[key]:.3f} of the benchmark's {key}" if key in target else ""
-            print(f"CLI {precision}: step loop {c['timing']['step_loop_s']:.3g} s, {rate:.3g} particle-steps/s{versus}")
-        else:
-            print(f"CLI {precision}: no result (see cli_{precision}.log)")
+        rates = {}
+        for pairs, name in (("auto", f"cli_{precision}"), ("never", f"cli_{precision}_single")):
+            c = load(os.path.join(out, f"{name}.json"))
+            if c and "timing" in c:
+                rate = rates[pairs] = c["timing"]["particle_steps_per_s"]
+                versus = f", {rate / target[key]:.3f} of the benchmark's {key}" if key in target else ""
+                used = c["filters"]["PF"]["estimator"].get("step_pairs", "?")
+                print(f"CLI {precision}, --step-pairs {pairs} ({used}): step loop {c['timing']['step_loop_s']:.3g} s, "
+                      f"{rate:.3g} particle-steps/s{versus}")
+            else:
+                print(f"CLI {precision}, --step-pairs {pairs}: no result (see {name}.log)")
+        if len(rates) == 2:
+            print(f"CLI {precision}: step pairs / single steps = {rates['auto'] / rates['never']:.3f}")
     for key, rate in target.items():
         print(f"target >= 6e10 particle-steps/s at M=1000, N=65536 ({key}): {'met' if rate >= 6e10 else 'NOT met'} ({rate:.3g})")
     report_sizes(out, "bench_particle_filter.json")
@@ -119,7 +125,7 @@ def main():
         m = med(rows, "particles_per_s")
         print(f"{name}: median {m[0]:.3g} particles/s (spread {m[1]:.3g}..{m[2]:.3g})")
     for t in ("test_particle_random", "test_resampling", "test_particle_filter", "test_particle_filter_references",
-              "test_grid_filter", "test_particle_snapshot"):
+              "test_grid_filter", "test_particle_snapshot", "test_filter_consistency"):
         r = load(os.path.join(out, f"{t}.json"))
         print(f"{t}: {r['tests'] - r['failures']}/{r['tests']} passed" if r else f"{t}: no result")
 

@@ -12,8 +12,8 @@
 #   test     the particle-filter test binaries (device vs host, systematic indices, statistical references)
 #   compare  M = 1000, N = 65536: kushner's PF step (fp64 and mixed, step and step_pair) and BM_StreamCopy (with
 #            power draw and SM clock sampled), then PyTorch eager and torch.compile, JAX fp64 and fp32, and the
-#            command line `kushner filter --model sine --filters PF` (fp64, mixed; summary.json's step-loop
-#            rate), in the same call (the side-by-side ratios)
+#            command line `kushner filter --model sine --filters PF` (fp64, mixed; each with --step-pairs auto
+#            and never; summary.json's step-loop rate), in the same call (the side-by-side ratios)
 #   sizes    every size M.N = 4e5 .. 1e9 (5 repetitions) and Kokkos vs Thrust resampling
 #   profile  Nsight Compute (ncu, where installed) on one launch of each step kernel at M = 1000, N = 65536:
 #            duration, throughput, occupancy, issue-slot use (ncu locks the clocks to base: durations are
@@ -53,14 +53,14 @@ if want build; then
 run configure cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON \
   -DKUSHNER_ENABLE_OPENMP=OFF -DKUSHNER_ENABLE_THRUST=ON -DKUSHNER_CUDA_ARCH="$arch" || { echo "configure failed"; exit 1; }
 run build cmake --build "$build" -j"$jobs" --target test_resampling test_particle_filter \
-  test_particle_filter_references test_grid_filter test_particle_snapshot test_particle_random bench_particle_filter \
-  bench_resampling kushner ||
+  test_particle_filter_references test_grid_filter test_particle_snapshot test_particle_random test_filter_consistency \
+  bench_particle_filter bench_resampling kushner ||
   { tail -50 "$out/build.log"; exit 1; }
 fi
 
 if want test; then
   for t in test_particle_random test_resampling test_particle_filter test_particle_filter_references test_grid_filter \
-    test_particle_snapshot; do
+    test_particle_snapshot test_filter_consistency; do
     run "$t" "$build/tests/$t" --gtest_output=json:"$out/$t.json"
   done
 fi
@@ -85,12 +85,16 @@ if want compare; then
   done
   # The command line: 1000 steps (dt 1e-3), the default 200 output points, no progress bar; summary.json's
   # timing.particle_steps_per_s is the step loop's rate (start-up and writing excluded).
+  # Each precision with step pairs (the default: the fused pass, the bank scoring one step behind) and without.
   for precision in fp64 mixed; do
-    rm -rf "$out/cli_$precision"
-    run "cli_$precision" "$build/kushner" filter --model sine --filters PF --members 1000 --particles 65536 \
-      --T 1 --dt 1e-3 --precision "$precision" --quiet --out "$out/cli_$precision"
-    cp "$out/cli_$precision/summary.json" "$out/cli_$precision.json" 2>/dev/null
-    rm -rf "$out/cli_$precision"
+    for pairs in auto never; do
+      name=cli_$precision; [ "$pairs" = auto ] || name=cli_${precision}_single
+      rm -rf "$out/$name"
+      run "$name" "$build/kushner" filter --model sine --filters PF --members 1000 --particles 65536 \
+        --T 1 --dt 1e-3 --precision "$precision" --step-pairs "$pairs" --quiet --out "$out/$name"
+      cp "$out/$name/summary.json" "$out/$name.json" 2>/dev/null
+      rm -rf "$out/$name"
+    done
   done
 fi
 if want sizes; then

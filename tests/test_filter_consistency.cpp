@@ -2,6 +2,8 @@
 // NEES over time and 10^4 members is the state dimension to within 3 standard errors (the bank's step is
 // the exact Kalman filter of the Euler-Maruyama truths, so E[NEES] = n at every time, not just as dt -> 0).
 // Power: a filter that assumes half the process noise intensity must fail the same test.
+// Step pairs (FilterBank::step_pair: the bank scores one step behind so that the particle filter takes two steps per
+// call) give the numbers of single steps.
 #include "engine/filter_run.hpp"
 #include "kernels/filters/filter_list.hpp"
 #include "models/linear_model.hpp"
@@ -9,6 +11,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <string>
 
 namespace kushner {
 namespace {
@@ -40,6 +44,70 @@ TEST(KalmanBucyConsistency, NeesWithinThreeStandardErrorsOfStateDimension) {
   overconfident.b = overconfident.b * std::sqrt(0.5);
   const Estimate off = kalman_bucy_nees(three, overconfident);
   EXPECT_GT(off.value - 3.0, 3.0 * off.standard_error) << off.value << " +- " << off.standard_error;
+}
+
+/// The same bits, NaN included.
+bool same(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+void expect_same_report(const FilterReport& a, const FilterReport& b, double relative) {
+  ASSERT_EQ(a.times, b.times);
+  ASSERT_EQ(a.filters, b.filters);
+  const auto close = [relative](double x, double y) {
+    return relative == 0.0 ? same(x, y) : (std::isnan(x) ? std::isnan(y) : std::abs(x - y) <= relative * std::abs(x));
+  };
+  for (std::size_t t = 0; t < a.times.size(); ++t)
+    for (std::size_t f = 0; f < a.filters.size(); ++f) {
+      const FilterSnapshot &x = a.series[t][f], &y = b.series[t][f];
+      EXPECT_TRUE(close(x.rmse_truth, y.rmse_truth) && close(x.nees, y.nees) && close(x.rmse_ref, y.rmse_ref) &&
+                  close(x.rmse_ref_se, y.rmse_ref_se) && x.diverged == y.diverged)
+          << a.filters[f] << " at t = " << a.times[t] << ": rmse_truth " << x.rmse_truth << " / " << y.rmse_truth
+          << ", rmse_ref " << x.rmse_ref << " / " << y.rmse_ref;
+    }
+  for (std::size_t f = 0; f < a.filters.size(); ++f) {
+    const FilterScores &x = a.scores[f], &y = b.scores[f];
+    EXPECT_TRUE(close(x.rmse_truth.value, y.rmse_truth.value) && close(x.nees.value, y.nees.value) &&
+                close(x.rmse_ref.value, y.rmse_ref.value) &&
+                close(x.rmse_ref.standard_error, y.rmse_ref.standard_error))
+        << a.filters[f] << ": rmse_ref " << x.rmse_ref.value << " / " << y.rmse_ref.value;
+  }
+  for (const char* field : {"mean_ess", "noise_floor"})
+    EXPECT_TRUE(close(std::get<double>(*find_field(a.estimators.at("PF"), field)),
+                      std::get<double>(*find_field(b.estimators.at("PF"), field))))
+        << field;
+}
+
+FilterReport run_with_pairs(StepPairs pairs, ParticleKernel kernel, const TimeGrid& grid) {
+  ParticleSettings particle;
+  particle.particles = 512;
+  particle.step_pairs = pairs;
+  particle.options.kernel = kernel;
+  const LinearModel<1> model;
+  return run_filters(Space(), model, model, 300, seed, grid, {"KB", "EKF", "PF", "EXACT"}, {}, particle);
+}
+
+std::string step_pairs_field(const FilterReport& report) {
+  return std::get<std::string>(*find_field(report.estimators.at("PF"), "step_pairs"));
+}
+
+TEST(StepPairs, ScoringOneStepBehindGivesTheNumbersOfSingleSteps) {
+  // 47 steps, 7 output times: pairs, the single steps that end at an output time, a single last step. Where the
+  // particle filter does not fuse a pair its two steps are step() twice, so every score, snapshot and PF figure
+  // must be the same bits as with single steps: any term scored against the wrong step's truth, estimate,
+  // status or reference mean would change them.
+  // (On a GPU the default kernel fuses them: there the first comparison is the second's.)
+  const TimeGrid grid = make_time_grid(0.47, 0.01, 7);
+  const bool fuses = ParticleFilterBank<Space, LinearModel<1>>::fuses_step_pairs({}, 512);
+  const FilterReport single = run_with_pairs(StepPairs::never, ParticleKernel::automatic, grid);
+  const FilterReport pairs = run_with_pairs(StepPairs::always, ParticleKernel::automatic, grid);
+  EXPECT_EQ(step_pairs_field(single), "off");
+  EXPECT_EQ(step_pairs_field(pairs), fuses ? "fused" : "unfused");
+  expect_same_report(single, pairs, fuses ? 1e-10 : 0.0);
+  // The team kernel fuses the two steps into one pass on the host too (as on a GPU): the same numbers but for the
+  // last bits of the sums.
+  const FilterReport team_single = run_with_pairs(StepPairs::never, ParticleKernel::team, grid);
+  const FilterReport team_fused = run_with_pairs(StepPairs::automatic, ParticleKernel::team, grid);
+  EXPECT_EQ(step_pairs_field(team_fused), "fused");
+  expect_same_report(team_single, team_fused, 1e-10);
 }
 
 }  // namespace

@@ -312,8 +312,8 @@ TEST(ParticleFilterBank, StepPairMatchesTwoSteps) {
   ASSERT_FALSE(unfused.fuses_step_pairs());
   BankVector<Kokkos::HostSpace> first_dy("first_dy", members, 1);
   auto current = [](const Bank& pf) {
-    return copy_posterior(
-        pf, Bank::PosteriorViews{pf.posterior_mean(), pf.posterior_covariance(), pf.effective_sample_size()});
+    return copy_posterior(pf, Bank::PosteriorViews{pf.posterior_mean(), pf.posterior_covariance(),
+                                                   pf.effective_sample_size(), pf.status()});
   };
   int redone_pairs = 0;
   for (int k = 0; k < steps; k += 2) {

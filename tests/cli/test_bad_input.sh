@@ -52,6 +52,8 @@ expect_refused "nan-model.toml: initial.x0_mean[0]: not finite" simulate --model
 expect_refused "--filters: empty name in ' '" filter --filters ' ' --out "$fresh"
 expect_refused "--filters: empty name in 'PF, '" filter --filters 'PF, ' --out "$fresh"
 expect_refused "--controllers: empty name in 'LQR@state,'" control --controllers 'LQR@state,' --out "$fresh"
+expect_refused "--step-pairs always: a closed loop's particle filter takes one step at a time" \
+  control --controllers LQR@PF --step-pairs always --out "$fresh"
 expect_refused "--set: expected key=value, got ' =1'" simulate --set ' =1' --out "$fresh"
 printf 'state_dim = 1\n\xcf\x83 = 1\n' >"$work/sigma.toml"
 expect_refused "sigma.toml: line 2, column 1: U+03C3 is a character the TOML reader of this build (toml++ 3.3.0) mishandles" \

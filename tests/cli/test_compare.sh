@@ -93,6 +93,28 @@ assert abs(mixed["PF"]["rmse_truth"] - fp64["PF"]["rmse_truth"]) < 1e-3, (mixed[
 assert mixed["PF"]["rmse_truth"] != fp64["PF"]["rmse_truth"], "mixed gave fp64's bits"
 PY
 echo "ok: --precision mixed"
+# Step pairs (the bank scoring one step behind so that PF takes two steps per call): on this host the two steps
+# run one after the other, so `always` must give every number of the default (`auto`: off here) bit for bit,
+# with an odd step count and output times that make some steps single.
+run_kushner "$work/p" filter --model sine --filters QLF,PF,EXACT --members 8 --particles 2048 --T 0.47 --dt 1e-2 \
+  --output-points 7 --step-pairs always --quiet --out "$work/p1"
+[ "$rc" -eq 0 ] || fail "filter with --step-pairs always failed: $(cat "$work/p.err")"
+run_kushner "$work/p" filter --model sine --filters QLF,PF,EXACT --members 8 --particles 2048 --T 0.47 --dt 1e-2 \
+  --output-points 7 --quiet --out "$work/p2"
+[ "$rc" -eq 0 ] || fail "filter with default step pairs failed: $(cat "$work/p.err")"
+python3 - "$work/p1" "$work/p2" <<'PY' || fail "step pairs changed the numbers"
+import json, os, sys
+pairs, single = (json.load(open(os.path.join(d, "summary.json"))) for d in sys.argv[1:3])
+assert pairs["filters"]["PF"]["estimator"]["step_pairs"] == "unfused", pairs["filters"]["PF"]
+assert single["filters"]["PF"]["estimator"]["step_pairs"] == "off", single["filters"]["PF"]
+for s in (pairs, single):
+    s["filters"]["PF"]["estimator"].pop("step_pairs")
+    s["memory"].pop("bank_bytes_per_member"); s["memory"].pop("total_bytes")
+assert pairs["filters"] == single["filters"], (pairs["filters"], single["filters"])
+rows = [[l for l in open(os.path.join(d, "timeseries.csv")) if not l.startswith("#")] for d in sys.argv[1:3]]
+assert rows[0] == rows[1] and len(rows[0]) > 7, "timeseries.csv differs"
+PY
+echo "ok: --step-pairs always gives the numbers of single steps"
 echo "ok: PF and EXACT"
 
 expect_refused() {  # expect_refused "message fragment" args...: one line, exit 2, nothing written
@@ -109,6 +131,7 @@ expect_refused "--resample: unknown scheme 'best'" compare --resample best
 expect_refused "--ess-threshold: must be in [0, 1] (got 1.5)" compare --ess-threshold 1.5
 expect_refused "--precision: unknown precision 'half' (known: fp64, mixed)" compare --precision half
 expect_refused "--precision fp32: not available" compare --precision fp32
+expect_refused "--step-pairs: unknown value 'sometimes' (known: auto, always, never)" compare --step-pairs sometimes
 expect_refused "--trajectory-members: member 99 is not in 0 .. 9" compare --members 10 --trajectory-members 99
 expect_refused "--density-times: 20 is not in [0, T = 10]" compare --density-times 20
 expect_refused "filter PF does not support model 'terpolymer' (state dimension above 4)" filter --model terpolymer --filters PF
