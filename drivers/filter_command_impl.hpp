@@ -3,6 +3,7 @@
 // filter_command_*.cpp files): select and check the filters, run the bank with the particle and exact
 // references beside it, write summary.json and timeseries.csv, and for compare the chosen members'
 // trajectories, the density snapshots, the plots and report.md.
+#include "core/collectives.hpp"
 #include "drivers/checkpoint_file.hpp"
 #include "drivers/csv.hpp"
 #include "drivers/fields_json.hpp"
@@ -77,12 +78,13 @@ inline nlohmann::json filter_summary(const FilterReport& report) {
 struct RunMemory {
   double bank_bytes_per_member = 0.0, particle_bytes_per_particle = 0.0, total_bytes = 0.0;
 };
-/// Whether the particle filter of `particle` fuses its step pairs on the selected backend.
+/// Whether the particle filter of `particle` fuses its step pairs on the selected backend (by its type: the
+/// options are checked before Kokkos starts).
 template <class Model>
 bool particle_fuses_step_pairs(const ParticleSettings& particle) {
   bool fuses = false;
-  with_backend(selected_backend(), [&](const auto& space) {
-    using ExecSpace = std::decay_t<decltype(space)>;
+  with_backend_type(selected_backend(), [&](auto* tag) {
+    using ExecSpace = std::remove_pointer_t<decltype(tag)>;
     fuses = ParticleFilterBank<ExecSpace, Model>::fuses_step_pairs(particle.options, particle.particles);
   });
   return fuses;
@@ -118,13 +120,15 @@ RunMemory run_memory(const CompareOptions& options, const std::vector<std::strin
 }
 
 /// The run's particle settings: the options', with step pairs off where `auto` would fuse them but the second
-/// particle bank does not fit (the run then needs what it needed before pairs existed).
+/// particle bank does not fit (the run then needs what it needed before pairs existed) on some MPI rank (so that
+/// every rank takes the same steps and reports the same).
 template <class Model>
 ParticleSettings run_particle_settings(const CompareOptions& options, const std::vector<std::string>& filters,
                                        const OptionValues& settings) {
   ParticleSettings particle = particle_settings(options);
   if (particle.step_pairs == StepPairs::automatic &&
-      !memory_fits(run_memory<Model>(options, filters, settings, particle).total_bytes, selected_backend()))
+      collective::any(
+          !memory_fits(run_memory<Model>(options, filters, settings, particle).total_bytes, selected_backend())))
     particle.step_pairs = StepPairs::never;
   return particle;
 }

@@ -8,6 +8,7 @@
 
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace kushner {
@@ -32,19 +33,26 @@ BackendDescription describe_backend(const std::string& name);
 /// /proc/meminfo on the host; nullopt where unknown. For the GPU it needs Kokkos initialized.
 std::optional<double> available_memory_bytes(const std::string& name);
 
-/// Calls f(space) with an instance of the execution space called `name`.
+/// Calls f(tag), tag a null pointer to the execution space called `name`: for what depends on its type only,
+/// also before Kokkos is initialized (an instance needs an initialized Kokkos; Kokkos 3.4's Cuda() complains).
 template <class F>
-void with_backend(const std::string& name, F&& f) {
+void with_backend_type(const std::string& name, F&& f) {
 #if defined(KOKKOS_ENABLE_CUDA)
-  if (name == "cuda") return f(Kokkos::Cuda());
+  if (name == "cuda") return f(static_cast<Kokkos::Cuda*>(nullptr));
 #endif
 #if defined(KOKKOS_ENABLE_OPENMP)
-  if (name == "openmp") return f(Kokkos::OpenMP());
+  if (name == "openmp") return f(static_cast<Kokkos::OpenMP*>(nullptr));
 #endif
 #if defined(KOKKOS_ENABLE_SERIAL)
-  if (name == "serial") return f(Kokkos::Serial());
+  if (name == "serial") return f(static_cast<Kokkos::Serial*>(nullptr));
 #endif
   KUSHNER_REQUIRE(false, "backend '" << name << "' is not compiled in");
+}
+
+/// Calls f(space) with an instance of the execution space called `name` (Kokkos initialized).
+template <class F>
+void with_backend(const std::string& name, F&& f) {
+  with_backend_type(name, [&](auto* tag) { f(std::remove_pointer_t<decltype(tag)>()); });
 }
 
 /// Kokkos::initialize / finalize around a run. Sets OMP_PROC_BIND=false when unset, which is libgomp's
