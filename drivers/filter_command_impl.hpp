@@ -104,8 +104,7 @@ RunMemory run_memory(const CompareOptions& options, const std::vector<std::strin
           ExactReferenceEstimator<Kokkos::DefaultHostExecutionSpace, Model>::bytes_per_member();
   const bool particle_filter = std::find(filters.begin(), filters.end(), particle_filter_name) != filters.end();
   const bool fuses = particle_filter && particle_fuses_step_pairs<Model>(particle);
-  const bool pairs = particle_filter && (particle.step_pairs == StepPairs::always ||
-                                         (particle.step_pairs == StepPairs::automatic && fuses));
+  const bool pairs = particle_filter && takes_step_pairs(particle.step_pairs, fuses);
   if (pairs) memory.bank_bytes_per_member += Bank::step_pair_bytes_per_member(static_cast<long>(filters.size()));
   memory.total_bytes = static_cast<double>(options.run.members) * memory.bank_bytes_per_member;
   if (particle_filter) {
@@ -113,7 +112,7 @@ RunMemory run_memory(const CompareOptions& options, const std::vector<std::strin
     memory.total_bytes += Particles::bytes_needed(options.run.members, particle.particles, particle.options);
   }
   if (pairs && fuses) {
-    memory.particle_bytes_per_particle += (Model::state_dim + 1.0) * sizeof(double);  // the second bank
+    memory.particle_bytes_per_particle += Particles::step_pair_bytes_per_particle();
     memory.total_bytes += Particles::step_pair_bytes_needed(options.run.members, particle.particles);
   }
   return memory;

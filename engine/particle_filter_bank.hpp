@@ -173,10 +173,12 @@ class ParticleFilterBank {
   static double step_pair_bytes_needed(long members, long particles) {
     const double blocks = static_cast<double>((particles + host_particle_block - 1) / host_particle_block);
     return static_cast<double>(members) *
-           (sizeof(double) * ((state_dim + 1.0) * static_cast<double>(particles) +
-                              blocks * WeightedMoments<state_dim>::size + 2.0 + state_dim + packed_size(state_dim)) +
+           (step_pair_bytes_per_particle() * static_cast<double>(particles) +
+            sizeof(double) * (blocks * WeightedMoments<state_dim>::size + 2.0 + state_dim + packed_size(state_dim)) +
             sizeof(Status));
   }
+  /// The second bank's state and log-weight.
+  static double step_pair_bytes_per_particle() { return sizeof(double) * (state_dim + 1.0); }
 
   /// Whether a bank with `options` and `particles` particles per member fuses step_pair's two steps (the team
   /// kernel with chunked systematic resampling).

@@ -35,6 +35,11 @@ constexpr const char* particle_filter_unsupported() {
 /// check), or never.
 enum class StepPairs { automatic, always, never };
 
+/// Whether the particle filter takes step pairs under `step_pairs`, given whether its kernel fuses them.
+inline bool takes_step_pairs(StepPairs step_pairs, bool fuses) {
+  return step_pairs == StepPairs::always || (step_pairs == StepPairs::automatic && fuses);
+}
+
 /// Particle-filter settings of `kushner filter` and `kushner compare`.
 struct ParticleSettings {
   int particles = 1024;
@@ -65,8 +70,7 @@ class ParticleReference final : public ReferenceEstimator<typename ExecSpace::me
       : space_(space),
         pf_(space, model, static_cast<int>(members), settings.particles, seed, settings.options),
         sums_("kushner::particle_reference_sums", members, 2),
-        in_pairs_(settings.step_pairs == StepPairs::always ||
-                  (settings.step_pairs == StepPairs::automatic && pf_.fuses_step_pairs())) {}
+        in_pairs_(takes_step_pairs(settings.step_pairs, pf_.fuses_step_pairs())) {}
 
   std::string name() const override { return particle_filter_name; }
   void advance(long k, double, double dt, const BankVector<MemSpace>& dy) override {
