@@ -8,6 +8,7 @@
 // the first one behind. Reductions go through ensemble_moments (fixed-order blocks), so every number is the same
 // on any number of threads.
 #include "engine/reference_estimator.hpp"
+#include "engine/shared_instances.hpp"
 #include "engine/truth_bank.hpp"
 #include "kernels/ensemble_moments.hpp"
 #include "kernels/filters/filter_bank_step.hpp"
@@ -133,60 +134,18 @@ class FilterBank {
   /// `kushner reproduce` runs filters of a Taylor model on the system it approximates).
   FilterBank(const ExecSpace& space, const TruthModel& truth_model, const Model& filter_model, long members, Seed seed,
              const std::vector<std::string>& filters, const OptionValues& options = {},
-             const PreparedFilters& prepared = {})
-      : space_(space),
-        truth_model_(truth_model),
-        filter_model_(filter_model),
-        members_(members),
-        seed_(seed),
-        truths_(space, truth_model, members, seed),
-        truth_status_("kushner::truth_status", members) {
-    for (const auto& name : filters) {
-      bool found = false;
-      for_each_slot([&](auto& slot) {
-        using Filter = decltype(slot.filter);
-        if (name != Filter::name) return;
-        found = true;
-        enable_filter_slot(slot, filter_model, members, options, std::get<std::optional<Filter>>(prepared), seed);
-      });
-      KUSHNER_REQUIRE(found, "filter '" << name << "' is not supported by model " << Model::name);
-    }
-    parallel_for_members("kushner::filter_bank_initial_score", space_, members_,
-                         typename K::Initial{truths_.state(), slots_});
-  }
+             const PreparedFilters& prepared = {});
 
   /// Scores every filter against `reference` from now on (call before the first step and before
   /// add_estimator). The bank steps it after each of its own steps (once, also when it is an estimator).
-  void set_reference(ReferenceEstimator<MemSpace>* reference) {
-    reference_ = reference;
-    if (reference_) score_reference(slots_, now(), true);
-  }
+  void set_reference(ReferenceEstimator<MemSpace>* reference);
 
   /// Steps `estimator` after every bank step and scores it like a filter, named estimator->name() (call
   /// before the first step; the bank does not own it).
-  void add_estimator(ReferenceEstimator<MemSpace>* estimator) {
-    KUSHNER_REQUIRE(estimator != nullptr, "add_estimator: null estimator");
-    Estimator e;
-    e.estimator = estimator;
-    e.name = estimator->name();
-    e.slot.enabled = true;
-    e.slot.score = BankVector<MemSpace>("kushner::score_" + e.name, members_, num_score_columns);
-    e.slot.snapshot = BankVector<MemSpace>("kushner::snapshot_" + e.name, members_, num_snapshot_columns);
-    estimators_.push_back(e);
-    score_estimator(estimators_.back(), estimator->estimate(), now(), true);
-  }
+  void add_estimator(ReferenceEstimator<MemSpace>* estimator);
 
   /// Step k, over [k dt, (k + 1) dt]; `record`: (k + 1) dt is an output time.
-  void step(long k, double dt, bool record) {
-    run_step_kernel(k, dt, record);
-    bool reference_stepped = false;
-    for (auto& e : estimators_) {
-      e.estimator->advance(k, k * dt, dt, truths_.observations());
-      reference_stepped = reference_stepped || e.estimator == reference_;
-    }
-    if (reference_ && !reference_stepped) reference_->advance(k, k * dt, dt, truths_.observations());
-    score_now(record);
-  }
+  void step(long k, double dt, bool record);
 
   /// Whether a run should call step_pair: the reference advances in pairs (ReferenceEstimator::advances_in_pairs).
   bool steps_in_pairs() const { return reference_ != nullptr && reference_->advances_in_pairs(); }
@@ -197,23 +156,7 @@ class FilterBank {
   /// kept before the bank takes step k + 1. Every score gets the same terms in the same order as step(k, dt,
   /// false) then step(k + 1, dt, record), so the numbers are those of the two steps wherever the reference's pair
   /// is (ParticleFilterBank::step_pair).
-  void step_pair(long k, double dt, bool record) {
-    KUSHNER_REQUIRE(steps_in_pairs(), "step_pair: the reference does not advance in pairs");
-    run_step_kernel(k, dt, false);
-    keep_step();
-    run_step_kernel(k + 1, dt, record);
-    reference_->advance_pair(k, k * dt, dt, kept_.dy, truths_.observations());
-    const EstimateViews<MemSpace> reference_then = reference_->first_of_pair();
-    const ScoredTime then{kept_.truth, kept_.truth_status, reference_then.mean, reference_then.status};
-    for (auto& e : estimators_)
-      if (e.estimator != reference_) e.estimator->advance(k, k * dt, dt, kept_.dy);
-    score_reference(kept_.slots, then, false);
-    for (auto& e : estimators_)
-      score_estimator(e, e.estimator == reference_ ? reference_then : e.estimator->estimate(), then, false);
-    for (auto& e : estimators_)
-      if (e.estimator != reference_) e.estimator->advance(k + 1, (k + 1) * dt, dt, truths_.observations());
-    score_now(record);
-  }
+  void step_pair(long k, double dt, bool record);
 
   /// Bytes step_pair keeps per member for `filters` filters: a step's truth, dy and statuses, each filter's m.
   static double step_pair_bytes_per_member(long filters) {
@@ -268,17 +211,7 @@ class FilterBank {
   }
 
   /// Per member: whether filter `name` and the member's truth are still finite and well defined.
-  std::vector<char> members_ok(const std::string& name) const {
-    std::vector<char> ok(members_, 0);
-    space_.fence();
-    const auto truth_status = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), truth_status_);
-    with_slot(name, [&](const auto& slot) {
-      const auto status = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), slot.status);
-      for (long member = 0; member < members_; ++member)
-        ok[member] = status(member) == Status::ok && truth_status(member) == Status::ok;
-    });
-    return ok;
-  }
+  std::vector<char> members_ok(const std::string& name) const;
 
   /// Metrics of filter `name` at the latest output time.
   FilterSnapshot snapshot(const std::string& name) const { return snapshots({name}).front(); }
@@ -286,88 +219,18 @@ class FilterBank {
   /// snapshot() of every filter of `names`: the moments of all their snapshot columns in one pass (ColumnMoments)
   /// and their divergence counts in another (DivergedCounts), whatever the number of filters: on a GPU each pass
   /// waits for the device once.
-  std::vector<FilterSnapshot> snapshots(const std::vector<std::string>& names) const {
-    std::vector<typename ColumnMoments<ExecSpace>::Column> columns;
-    std::vector<BankScalar<Status, MemSpace>> statuses;
-    std::vector<int> first;  // names[i]'s columns start at first[i]: squared error, NEES[, reference]
-    for (const auto& name : names)
-      with_slot(name, [&](const auto& slot) {
-        first.push_back(static_cast<int>(columns.size()));
-        columns.push_back(Kokkos::subview(slot.snapshot, Kokkos::ALL, int(snapshot_squared_error)));
-        columns.push_back(Kokkos::subview(slot.snapshot, Kokkos::ALL, int(snapshot_nees)));
-        if (scored_against_reference(name))
-          columns.push_back(Kokkos::subview(slot.snapshot, Kokkos::ALL, int(snapshot_reference_squared_error)));
-        statuses.push_back(slot.status);
-      });
-    const std::vector<EnsembleMoments> moments = snapshot_moments_(space_, columns);
-    const std::vector<long> diverged = diverged_counts_(space_, statuses, truth_status_);
-    std::vector<FilterSnapshot> result;
-    for (std::size_t i = 0; i < names.size(); ++i) {
-      FilterSnapshot s;
-      const Estimate rmse = root_mean(moments[first[i]]);
-      const Estimate nees = mean(moments[first[i] + 1]);
-      const Estimate ref = scored_against_reference(names[i]) ? root_mean(moments[first[i] + 2])
-                                                              : Estimate{std::nan(""), std::nan(""), 0};
-      s.rmse_truth = rmse.value;
-      s.rmse_truth_se = rmse.standard_error;
-      s.nees = nees.value;
-      s.nees_se = nees.standard_error;
-      s.rmse_ref = ref.value;
-      s.rmse_ref_se = ref.standard_error;
-      s.diverged = diverged[i];
-      result.push_back(s);
-    }
-    return result;
-  }
+  std::vector<FilterSnapshot> snapshots(const std::vector<std::string>& names) const;
 
   /// Metrics of filter `name` over the run so far: `points` time points have been scored (steps + 1).
-  FilterScores scores(const std::string& name, long points) const {
-    FilterScores s;
-    with_slot(name, [&](const auto& slot) {
-      BankVector<MemSpace> per_member("kushner::member_scores", members_, num_member_score_columns);
-      parallel_for_members("kushner::member_scores", space_, members_,
-                           MemberScores<MemSpace>{slot.score, slot.status, truth_status_, per_member,
-                                                  static_cast<double>(points), scored_against_reference(name),
-                                                  reference_ ? reference_->status() : BankScalar<Status, MemSpace>()});
-      s.rmse_truth = root_mean(per_member, member_mean_squared_error);
-      s.nees = mean(per_member, member_mean_nees);
-      s.rmse_ref = root_mean(per_member, member_mean_squared_reference_error);
-      s.not_positive_definite = count_status(space_, slot.status, Status::not_positive_definite, truth_status_);
-      s.non_finite = count_status(space_, slot.status, Status::non_finite, truth_status_);
-      s.diverged = s.not_positive_definite + s.non_finite;
-    });
-    return s;
-  }
+  FilterScores scores(const std::string& name, long points) const;
 
   /// Saves or loads the bank's state for a checkpoint: truths, per filter its m, P, status, scores,
   /// snapshot and own state, per outside estimator its scores (the estimators save themselves). Draws are keyed
   /// by step, so nothing else carries from one step to the next.
-  void visit_state(StateArchive& archive) {
-    archive.scope = "truth.";
-    archive.view("x", truths_.state());
-    archive.view("observations", truths_.observations());
-    archive.view("status", truth_status_);
-    for_each_slot([&](auto& slot) {
-      using Filter = decltype(slot.filter);
-      if (!slot.enabled) return;
-      archive.scope = std::string(Filter::name) + ".";
-      archive.view("m", slot.m);
-      archive.view("P", slot.P);
-      archive.view("status", slot.status);
-      archive.view("score", slot.score);
-      archive.view("snapshot", slot.snapshot);
-      if constexpr (detail::has_own_state<Filter, StateArchive>::value) slot.filter.visit_state(archive);
-    });
-    for (auto& e : estimators_) {
-      archive.scope = e.name + ".";
-      archive.view("score", e.slot.score);
-      archive.view("snapshot", e.slot.snapshot);
-    }
-    archive.scope.clear();
-  }
+  void visit_state(StateArchive& archive);
 
   /// Members whose truth escaped to infinity (left out of every metric).
-  long truths_escaped() const { return count_status(space_, truth_status_, Status::non_finite); }
+  long truths_escaped() const;
 
  private:
   template <class F>
@@ -521,5 +384,183 @@ class FilterBank {
   mutable ColumnMoments<ExecSpace> snapshot_moments_;  // buffers kept from one output step to the next
   mutable DivergedCounts<ExecSpace> diverged_counts_;
 };
+
+template <class ExecSpace, class Model, class TruthModel>
+FilterBank<ExecSpace, Model, TruthModel>::FilterBank(const ExecSpace& space, const TruthModel& truth_model,
+                                                     const Model& filter_model, long members, Seed seed,
+                                                     const std::vector<std::string>& filters,
+                                                     const OptionValues& options, const PreparedFilters& prepared)
+    : space_(space),
+      truth_model_(truth_model),
+      filter_model_(filter_model),
+      members_(members),
+      seed_(seed),
+      truths_(space, truth_model, members, seed),
+      truth_status_("kushner::truth_status", members) {
+  for (const auto& name : filters) {
+    bool found = false;
+    for_each_slot([&](auto& slot) {
+      using Filter = decltype(slot.filter);
+      if (name != Filter::name) return;
+      found = true;
+      enable_filter_slot(slot, filter_model, members, options, std::get<std::optional<Filter>>(prepared), seed);
+    });
+    KUSHNER_REQUIRE(found, "filter '" << name << "' is not supported by model " << Model::name);
+  }
+  parallel_for_members("kushner::filter_bank_initial_score", space_, members_,
+                       typename K::Initial{truths_.state(), slots_});
+}
+
+template <class ExecSpace, class Model, class TruthModel>
+void FilterBank<ExecSpace, Model, TruthModel>::set_reference(ReferenceEstimator<MemSpace>* reference) {
+  reference_ = reference;
+  if (reference_) score_reference(slots_, now(), true);
+}
+
+template <class ExecSpace, class Model, class TruthModel>
+void FilterBank<ExecSpace, Model, TruthModel>::add_estimator(ReferenceEstimator<MemSpace>* estimator) {
+  KUSHNER_REQUIRE(estimator != nullptr, "add_estimator: null estimator");
+  Estimator e;
+  e.estimator = estimator;
+  e.name = estimator->name();
+  e.slot.enabled = true;
+  e.slot.score = BankVector<MemSpace>("kushner::score_" + e.name, members_, num_score_columns);
+  e.slot.snapshot = BankVector<MemSpace>("kushner::snapshot_" + e.name, members_, num_snapshot_columns);
+  estimators_.push_back(e);
+  score_estimator(estimators_.back(), estimator->estimate(), now(), true);
+}
+
+template <class ExecSpace, class Model, class TruthModel>
+void FilterBank<ExecSpace, Model, TruthModel>::step(long k, double dt, bool record) {
+  run_step_kernel(k, dt, record);
+  bool reference_stepped = false;
+  for (auto& e : estimators_) {
+    e.estimator->advance(k, k * dt, dt, truths_.observations());
+    reference_stepped = reference_stepped || e.estimator == reference_;
+  }
+  if (reference_ && !reference_stepped) reference_->advance(k, k * dt, dt, truths_.observations());
+  score_now(record);
+}
+
+template <class ExecSpace, class Model, class TruthModel>
+void FilterBank<ExecSpace, Model, TruthModel>::step_pair(long k, double dt, bool record) {
+  KUSHNER_REQUIRE(steps_in_pairs(), "step_pair: the reference does not advance in pairs");
+  run_step_kernel(k, dt, false);
+  keep_step();
+  run_step_kernel(k + 1, dt, record);
+  reference_->advance_pair(k, k * dt, dt, kept_.dy, truths_.observations());
+  const EstimateViews<MemSpace> reference_then = reference_->first_of_pair();
+  const ScoredTime then{kept_.truth, kept_.truth_status, reference_then.mean, reference_then.status};
+  for (auto& e : estimators_)
+    if (e.estimator != reference_) e.estimator->advance(k, k * dt, dt, kept_.dy);
+  score_reference(kept_.slots, then, false);
+  for (auto& e : estimators_)
+    score_estimator(e, e.estimator == reference_ ? reference_then : e.estimator->estimate(), then, false);
+  for (auto& e : estimators_)
+    if (e.estimator != reference_) e.estimator->advance(k + 1, (k + 1) * dt, dt, truths_.observations());
+  score_now(record);
+}
+
+template <class ExecSpace, class Model, class TruthModel>
+std::vector<char> FilterBank<ExecSpace, Model, TruthModel>::members_ok(const std::string& name) const {
+  std::vector<char> ok(members_, 0);
+  space_.fence();
+  const auto truth_status = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), truth_status_);
+  with_slot(name, [&](const auto& slot) {
+    const auto status = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), slot.status);
+    for (long member = 0; member < members_; ++member)
+      ok[member] = status(member) == Status::ok && truth_status(member) == Status::ok;
+  });
+  return ok;
+}
+
+template <class ExecSpace, class Model, class TruthModel>
+std::vector<FilterSnapshot> FilterBank<ExecSpace, Model, TruthModel>::snapshots(
+    const std::vector<std::string>& names) const {
+  std::vector<typename ColumnMoments<ExecSpace>::Column> columns;
+  std::vector<BankScalar<Status, MemSpace>> statuses;
+  std::vector<int> first;  // names[i]'s columns start at first[i]: squared error, NEES[, reference]
+  for (const auto& name : names)
+    with_slot(name, [&](const auto& slot) {
+      first.push_back(static_cast<int>(columns.size()));
+      columns.push_back(Kokkos::subview(slot.snapshot, Kokkos::ALL, int(snapshot_squared_error)));
+      columns.push_back(Kokkos::subview(slot.snapshot, Kokkos::ALL, int(snapshot_nees)));
+      if (scored_against_reference(name))
+        columns.push_back(Kokkos::subview(slot.snapshot, Kokkos::ALL, int(snapshot_reference_squared_error)));
+      statuses.push_back(slot.status);
+    });
+  const std::vector<EnsembleMoments> moments = snapshot_moments_(space_, columns);
+  const std::vector<long> diverged = diverged_counts_(space_, statuses, truth_status_);
+  std::vector<FilterSnapshot> result;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    FilterSnapshot s;
+    const Estimate rmse = root_mean(moments[first[i]]);
+    const Estimate nees = mean(moments[first[i] + 1]);
+    const Estimate ref =
+        scored_against_reference(names[i]) ? root_mean(moments[first[i] + 2]) : Estimate{std::nan(""), std::nan(""), 0};
+    s.rmse_truth = rmse.value;
+    s.rmse_truth_se = rmse.standard_error;
+    s.nees = nees.value;
+    s.nees_se = nees.standard_error;
+    s.rmse_ref = ref.value;
+    s.rmse_ref_se = ref.standard_error;
+    s.diverged = diverged[i];
+    result.push_back(s);
+  }
+  return result;
+}
+
+template <class ExecSpace, class Model, class TruthModel>
+FilterScores FilterBank<ExecSpace, Model, TruthModel>::scores(const std::string& name, long points) const {
+  FilterScores s;
+  with_slot(name, [&](const auto& slot) {
+    BankVector<MemSpace> per_member("kushner::member_scores", members_, num_member_score_columns);
+    parallel_for_members("kushner::member_scores", space_, members_,
+                         MemberScores<MemSpace>{slot.score, slot.status, truth_status_, per_member,
+                                                static_cast<double>(points), scored_against_reference(name),
+                                                reference_ ? reference_->status() : BankScalar<Status, MemSpace>()});
+    s.rmse_truth = root_mean(per_member, member_mean_squared_error);
+    s.nees = mean(per_member, member_mean_nees);
+    s.rmse_ref = root_mean(per_member, member_mean_squared_reference_error);
+    s.not_positive_definite = count_status(space_, slot.status, Status::not_positive_definite, truth_status_);
+    s.non_finite = count_status(space_, slot.status, Status::non_finite, truth_status_);
+    s.diverged = s.not_positive_definite + s.non_finite;
+  });
+  return s;
+}
+
+template <class ExecSpace, class Model, class TruthModel>
+void FilterBank<ExecSpace, Model, TruthModel>::visit_state(StateArchive& archive) {
+  archive.scope = "truth.";
+  archive.view("x", truths_.state());
+  archive.view("observations", truths_.observations());
+  archive.view("status", truth_status_);
+  for_each_slot([&](auto& slot) {
+    using Filter = decltype(slot.filter);
+    if (!slot.enabled) return;
+    archive.scope = std::string(Filter::name) + ".";
+    archive.view("m", slot.m);
+    archive.view("P", slot.P);
+    archive.view("status", slot.status);
+    archive.view("score", slot.score);
+    archive.view("snapshot", slot.snapshot);
+    if constexpr (detail::has_own_state<Filter, StateArchive>::value) slot.filter.visit_state(archive);
+  });
+  for (auto& e : estimators_) {
+    archive.scope = e.name + ".";
+    archive.view("score", e.slot.score);
+    archive.view("snapshot", e.slot.snapshot);
+  }
+  archive.scope.clear();
+}
+
+template <class ExecSpace, class Model, class TruthModel>
+long FilterBank<ExecSpace, Model, TruthModel>::truths_escaped() const {
+  return count_status(space_, truth_status_, Status::non_finite);
+}
+
+#define KUSHNER_SHARED_INSTANCE(Space, Model) extern template class FilterBank<Space, Model>;
+KUSHNER_FOR_EACH_SHARED_INSTANCE
+#undef KUSHNER_SHARED_INSTANCE
 
 }  // namespace kushner

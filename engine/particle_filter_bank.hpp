@@ -21,6 +21,7 @@
 #include "core/eigen_helpers.hpp"
 #include "core/errors.hpp"
 #include "core/linear_algebra.hpp"
+#include "engine/shared_instances.hpp"
 #include "kernels/bank.hpp"
 #include "kernels/for_each_member.hpp"
 #include "kernels/particle_filter/chunked_systematic_resample.hpp"
@@ -43,6 +44,17 @@
 #include <utility>
 
 namespace kushner {
+
+/// Largest state dimension of the particle filter: its GPU kernel keeps each thread's weighted moments
+/// (3 + n + n(n+1)/2 doubles) in shared memory, which a 10-state model would overflow.
+constexpr int max_particle_filter_dim = 4;
+
+/// Why the particle filter cannot run Model, or nullptr.
+template <class Model>
+constexpr const char* particle_filter_unsupported() {
+  if (Model::state_dim > max_particle_filter_dim) return "state dimension above 4";
+  return nullptr;
+}
 
 /// Which step kernel runs: the host's SIMD block kernel, or the team kernel written for GPUs (which also
 /// runs on host spaces, for testing it where there is no GPU).
@@ -77,77 +89,11 @@ class ParticleFilterBank {
   /// Samples the initial particles and computes the time-0 posterior. Requires sizes >= 1 and a threshold in
   /// [0, 1] (std::logic_error otherwise: user input is checked where it is read, drivers/filter_options.cpp).
   ParticleFilterBank(const ExecSpace& space, const Model& model, int num_members, int num_particles, Seed seed,
-                     const ParticleFilterOptions& options)
-      : space_(space),
-        model_(model),
-        options_(options),
-        seed_(seed),
-        num_members_(num_members),
-        num_particles_(num_particles) {
-    KUSHNER_REQUIRE(num_members >= 1, "members: " << num_members);
-    KUSHNER_REQUIRE(num_particles >= 1, "particles: " << num_particles);
-    KUSHNER_REQUIRE(options.ess_threshold >= 0.0 && options.ess_threshold <= 1.0,
-                    "ess_threshold: " << options.ess_threshold);
-    use_team_ = uses_team_kernel(options);
-    constexpr bool host_memory = std::is_same<MemSpace, Kokkos::HostSpace>::value;
-    KUSHNER_REQUIRE(use_team_ || host_memory, "the host block kernel needs host memory");
-    team_size_ = options.team_size > 0 ? options.team_size : (host_memory ? 1 : device_particle_team);
-    const int per_thread =
-        options.particles_per_thread > 0 ? options.particles_per_thread : device_particles_per_thread;
-    // The team kernel on the host (tests) keeps 1024-particle chunks, so small tests still merge several.
-    block_size_ = use_team_ ? (host_memory ? 1024 : team_size_ * per_thread) : host_particle_block;
-    num_blocks_ = (num_particles + block_size_ - 1) / block_size_;
-    KUSHNER_REQUIRE(block_size_ % 2 == 0,
-                    "particle blocks must hold whole pairs of particles (block of " << block_size_ << ")");
-
-    const int n = state_dim;
-    x_ = ParticleBank<MemSpace>("kushner::particles", num_particles, num_members, n);
-    x_scratch_ = ParticleBank<MemSpace>("kushner::particles_scratch", num_particles, num_members, n);
-    workspace_.cumulative = decltype(workspace_.cumulative)("kushner::log_weights", num_particles, num_members);
-    workspace_.ancestors = decltype(workspace_.ancestors)("kushner::ancestors", num_particles, num_members);
-    use_chunked_resample_ = fuses_step_pairs(options, num_particles);
-    if (use_chunked_resample_) {
-      resample_list_ = Kokkos::View<int*, MemSpace>("kushner::resample_list", num_members);
-      resample_list_size_ = Kokkos::View<int, MemSpace>("kushner::resample_list_size");
-      block_sums_ = decltype(block_sums_)("kushner::resample_block_sums", scan_num_blocks(num_particles), num_members);
-    }
-    if (options.scheme == ResamplingScheme::residual)
-      workspace_.copies = decltype(workspace_.copies)("kushner::offspring", num_particles, num_members);
-    partials_ = decltype(partials_)("kushner::particle_partials", num_blocks_, num_members, WeightedMoments<n>::size);
-    log_normalizer_ = BankScalar<double, MemSpace>("kushner::log_normalizer", num_members);
-    reference_ = BankVector<MemSpace>("kushner::particle_reference", num_members, n);
-    mean_ = BankVector<MemSpace>("kushner::particle_mean", num_members, n);
-    covariance_ = BankSymmetric<MemSpace>("kushner::particle_covariance", num_members, packed_size(n));
-    ess_ = BankScalar<double, MemSpace>("kushner::ess", num_members);
-    resample_ = BankScalar<int, MemSpace>("kushner::resample_now", num_members);
-    resample_count_ = BankScalar<int, MemSpace>("kushner::resample_count", num_members);
-    status_ = BankScalar<Status, MemSpace>("kushner::particle_status", num_members);
-
-    const bool prior = options.initial_law == ParticleInitialLaw::prior;
-    const Vec<n> initial_mean = prior ? model.prior_mean : model.x0_mean;
-    const Mat<n, n> initial_root = covariance_square_root(prior ? model.prior_cov : model.x0_cov);
-    auto reference = Kokkos::create_mirror_view(reference_);  // moments are taken relative to the initial mean
-    for (int m = 0; m < num_members; ++m) store(reference, m, initial_mean);
-    Kokkos::deep_copy(space_, reference_, reference);
-    ParticleStepData<Model, MemSpace> d = step_data(0.0, 0.0, 0, BankVector<MemSpace>());
-    d.initialize = true;
-    d.initial_mean = initial_mean;
-    d.initial_root = initial_root;
-    run_step_kernels(d);
-  }
+                     const ParticleFilterOptions& options);
 
   /// Step k: [k dt, (k + 1) dt] with the members' observation increments dy (member, j) over it, and in a closed
   /// loop the control (member, j) each member's truth was driven by over it (empty: none).
-  void step(long k, double dt, const BankVector<MemSpace>& dy, const BankVector<MemSpace>& control = {}) {
-    require_increments_shape(dy);
-    KUSHNER_REQUIRE(k >= 0 && k < (1L << 32), "step " << k << " outside the counter range");
-    KUSHNER_REQUIRE(control.extent(0) == 0 ||
-                        (control.extent_int(0) == num_members_ && control.extent_int(1) == Model::control_dim),
-                    "control bank has shape (" << control.extent(0) << ", " << control.extent(1) << ")");
-    ParticleStepData<Model, MemSpace> d = step_data(k * dt, dt, static_cast<std::uint32_t>(k), dy);
-    d.control = control;
-    run_step_kernels(d);
-  }
+  void step(long k, double dt, const BankVector<MemSpace>& dy, const BankVector<MemSpace>& control = {});
 
   /// Bytes the bank allocates for `members` members of `particles` particles: per particle its state and the
   /// resampling scratch copy, its log-weight and ancestor index (and offspring count for residual resampling);
@@ -194,55 +140,7 @@ class ParticleFilterBank {
   /// again from the untouched first bank: step k, resampling, step k + 1, on the listed members only.
   /// Otherwise it is the two steps. Afterwards the posterior accessors give step k + 1 and first_step()
   /// step k.
-  void step_pair(long k, double dt, const BankVector<MemSpace>& dy, const BankVector<MemSpace>& dy_next) {
-    KUSHNER_REQUIRE(k >= 0 && k + 1 < (1L << 32), "steps " << k << ", " << k + 1 << " outside the counter range");
-    allocate_first_step();
-    if (!use_chunked_resample_) {
-      step(k, dt, dy);
-      Kokkos::deep_copy(space_, first_.mean, mean_);
-      Kokkos::deep_copy(space_, first_.covariance, covariance_);
-      Kokkos::deep_copy(space_, first_.ess, ess_);
-      Kokkos::deep_copy(space_, first_.status, status_);
-      step(k + 1, dt, dy_next);
-      return;
-    }
-    require_increments_shape(dy);
-    require_increments_shape(dy_next);
-    if (x_next_.extent(0) == 0) {
-      x_next_ = ParticleBank<MemSpace>("kushner::particles_next", num_particles_, num_members_, state_dim);
-      log_weight_next_ = decltype(log_weight_next_)("kushner::log_weights_next", num_particles_, num_members_);
-      partials_next_ = decltype(partials_next_)("kushner::particle_partials_next", num_blocks_, num_members_,
-                                                WeightedMoments<state_dim>::size);
-    }
-    const auto first = static_cast<std::uint32_t>(k), second = first + 1;
-    const ParticleSecondStep<Model, MemSpace> next{
-        x_next_, log_weight_next_, dy_next, partials_next_, observation_precision((k + 1) * dt), (k + 1) * dt};
-    run_team_kernel(ParticleTeamPairStep<Model, ExecSpace>{step_data(k * dt, dt, first, dy), next});
-    // The pass's output becomes the bank; its input (step k - 1's particles) stays for the redo.
-    std::swap(x_, x_next_);
-    std::swap(workspace_.cumulative, log_weight_next_);
-    // Step k's posterior. The reference point and log-normalizer stay step k - 1's: both steps of the pass
-    // were taken relative to them.
-    Kokkos::deep_copy(space_, resample_list_size_, 0);
-    run_posterior(partials_, first_, first_log_normalizer_, false);
-    Kokkos::deep_copy(space_, first_.status, status_);
-    // The members step k resamples: copy their step k - 1 particles back, step k, resample, step k + 1.
-    const long copy_items = static_cast<long>(num_members_) * num_particles_;
-    copy_listed_members<state_dim>(
-        space_, CopyListedMembers<state_dim, MemSpace>{
-                    x_next_, x_, log_weight_next_, workspace_.cumulative, resample_list_, resample_list_size_,
-                    num_particles_, copy_items < listed_copy_items ? copy_items : listed_copy_items});
-    run_team_kernel_listed(ParticleTeamStep<Model, ExecSpace>{step_data(k * dt, dt, first, dy)});
-    resample_listed(first_log_normalizer_, first);
-    ParticleStepData<Model, MemSpace> redo = step_data((k + 1) * dt, dt, second, dy_next);
-    redo.log_normalizer = first_log_normalizer_;  // log N after the resampling
-    redo.partials = partials_next_;
-    run_team_kernel_listed(ParticleTeamStep<Model, ExecSpace>{redo});
-    // Step k + 1's posterior and resampling, as in step().
-    Kokkos::deep_copy(space_, resample_list_size_, 0);
-    run_posterior(partials_next_, current_posterior(), log_normalizer_, true);
-    resample_listed(log_normalizer_, second);
-  }
+  void step_pair(long k, double dt, const BankVector<MemSpace>& dy, const BankVector<MemSpace>& dy_next);
 
   /// The posterior after the first step of the last step_pair (allocated by the first step_pair): (member, i),
   /// (member, packed), (member), and the members' status then.
@@ -271,12 +169,7 @@ class ParticleFilterBank {
   /// (member, i): sqrt(P_ii / ESS), the Monte Carlo standard error of the posterior mean as if the ESS
   /// particles were independent draws from the posterior (Kong, Liu & Wong 1994). It ignores the variance
   /// that earlier resamplings added, so it understates the error; independent seeds give the honest figure.
-  BankVector<MemSpace> monte_carlo_standard_error() const {
-    BankVector<MemSpace> se("kushner::particle_mc_se", num_members_, state_dim);
-    parallel_for_members("kushner::particle_mc_se", space_, num_members_,
-                         MonteCarloStandardError<state_dim, MemSpace>{covariance_, ess_, se});
-    return se;
-  }
+  BankVector<MemSpace> monte_carlo_standard_error() const;
   /// (member): ok, or non_finite once every particle of the member has left the finite numbers.
   const BankScalar<Status, MemSpace>& status() const { return status_; }
   /// (particle, member, i) and (particle, member): the particles and their log-weights; the normalized weight
@@ -492,5 +385,155 @@ class ParticleFilterBank {
   BankScalar<int, MemSpace> resample_, resample_count_;
   BankScalar<Status, MemSpace> status_;
 };
+
+template <class ExecSpace, class Model>
+ParticleFilterBank<ExecSpace, Model>::ParticleFilterBank(const ExecSpace& space, const Model& model, int num_members,
+                                                         int num_particles, Seed seed,
+                                                         const ParticleFilterOptions& options)
+    : space_(space),
+      model_(model),
+      options_(options),
+      seed_(seed),
+      num_members_(num_members),
+      num_particles_(num_particles) {
+  KUSHNER_REQUIRE(num_members >= 1, "members: " << num_members);
+  KUSHNER_REQUIRE(num_particles >= 1, "particles: " << num_particles);
+  KUSHNER_REQUIRE(options.ess_threshold >= 0.0 && options.ess_threshold <= 1.0,
+                  "ess_threshold: " << options.ess_threshold);
+  use_team_ = uses_team_kernel(options);
+  constexpr bool host_memory = std::is_same<MemSpace, Kokkos::HostSpace>::value;
+  KUSHNER_REQUIRE(use_team_ || host_memory, "the host block kernel needs host memory");
+  team_size_ = options.team_size > 0 ? options.team_size : (host_memory ? 1 : device_particle_team);
+  const int per_thread = options.particles_per_thread > 0 ? options.particles_per_thread : device_particles_per_thread;
+  // The team kernel on the host (tests) keeps 1024-particle chunks, so small tests still merge several.
+  block_size_ = use_team_ ? (host_memory ? 1024 : team_size_ * per_thread) : host_particle_block;
+  num_blocks_ = (num_particles + block_size_ - 1) / block_size_;
+  KUSHNER_REQUIRE(block_size_ % 2 == 0,
+                  "particle blocks must hold whole pairs of particles (block of " << block_size_ << ")");
+
+  const int n = state_dim;
+  x_ = ParticleBank<MemSpace>("kushner::particles", num_particles, num_members, n);
+  x_scratch_ = ParticleBank<MemSpace>("kushner::particles_scratch", num_particles, num_members, n);
+  workspace_.cumulative = decltype(workspace_.cumulative)("kushner::log_weights", num_particles, num_members);
+  workspace_.ancestors = decltype(workspace_.ancestors)("kushner::ancestors", num_particles, num_members);
+  use_chunked_resample_ = fuses_step_pairs(options, num_particles);
+  if (use_chunked_resample_) {
+    resample_list_ = Kokkos::View<int*, MemSpace>("kushner::resample_list", num_members);
+    resample_list_size_ = Kokkos::View<int, MemSpace>("kushner::resample_list_size");
+    block_sums_ = decltype(block_sums_)("kushner::resample_block_sums", scan_num_blocks(num_particles), num_members);
+  }
+  if (options.scheme == ResamplingScheme::residual)
+    workspace_.copies = decltype(workspace_.copies)("kushner::offspring", num_particles, num_members);
+  partials_ = decltype(partials_)("kushner::particle_partials", num_blocks_, num_members, WeightedMoments<n>::size);
+  log_normalizer_ = BankScalar<double, MemSpace>("kushner::log_normalizer", num_members);
+  reference_ = BankVector<MemSpace>("kushner::particle_reference", num_members, n);
+  mean_ = BankVector<MemSpace>("kushner::particle_mean", num_members, n);
+  covariance_ = BankSymmetric<MemSpace>("kushner::particle_covariance", num_members, packed_size(n));
+  ess_ = BankScalar<double, MemSpace>("kushner::ess", num_members);
+  resample_ = BankScalar<int, MemSpace>("kushner::resample_now", num_members);
+  resample_count_ = BankScalar<int, MemSpace>("kushner::resample_count", num_members);
+  status_ = BankScalar<Status, MemSpace>("kushner::particle_status", num_members);
+
+  const bool prior = options.initial_law == ParticleInitialLaw::prior;
+  const Vec<n> initial_mean = prior ? model.prior_mean : model.x0_mean;
+  const Mat<n, n> initial_root = covariance_square_root(prior ? model.prior_cov : model.x0_cov);
+  auto reference = Kokkos::create_mirror_view(reference_);  // moments are taken relative to the initial mean
+  for (int m = 0; m < num_members; ++m) store(reference, m, initial_mean);
+  Kokkos::deep_copy(space_, reference_, reference);
+  ParticleStepData<Model, MemSpace> d = step_data(0.0, 0.0, 0, BankVector<MemSpace>());
+  d.initialize = true;
+  d.initial_mean = initial_mean;
+  d.initial_root = initial_root;
+  run_step_kernels(d);
+}
+
+template <class ExecSpace, class Model>
+void ParticleFilterBank<ExecSpace, Model>::step(long k, double dt, const BankVector<MemSpace>& dy,
+                                                const BankVector<MemSpace>& control) {
+  require_increments_shape(dy);
+  KUSHNER_REQUIRE(k >= 0 && k < (1L << 32), "step " << k << " outside the counter range");
+  KUSHNER_REQUIRE(
+      control.extent(0) == 0 || (control.extent_int(0) == num_members_ && control.extent_int(1) == Model::control_dim),
+      "control bank has shape (" << control.extent(0) << ", " << control.extent(1) << ")");
+  ParticleStepData<Model, MemSpace> d = step_data(k * dt, dt, static_cast<std::uint32_t>(k), dy);
+  d.control = control;
+  run_step_kernels(d);
+}
+
+template <class ExecSpace, class Model>
+void ParticleFilterBank<ExecSpace, Model>::step_pair(long k, double dt, const BankVector<MemSpace>& dy,
+                                                     const BankVector<MemSpace>& dy_next) {
+  KUSHNER_REQUIRE(k >= 0 && k + 1 < (1L << 32), "steps " << k << ", " << k + 1 << " outside the counter range");
+  allocate_first_step();
+  if (!use_chunked_resample_) {
+    step(k, dt, dy);
+    Kokkos::deep_copy(space_, first_.mean, mean_);
+    Kokkos::deep_copy(space_, first_.covariance, covariance_);
+    Kokkos::deep_copy(space_, first_.ess, ess_);
+    Kokkos::deep_copy(space_, first_.status, status_);
+    step(k + 1, dt, dy_next);
+    return;
+  }
+  require_increments_shape(dy);
+  require_increments_shape(dy_next);
+  if (x_next_.extent(0) == 0) {
+    x_next_ = ParticleBank<MemSpace>("kushner::particles_next", num_particles_, num_members_, state_dim);
+    log_weight_next_ = decltype(log_weight_next_)("kushner::log_weights_next", num_particles_, num_members_);
+    partials_next_ = decltype(partials_next_)("kushner::particle_partials_next", num_blocks_, num_members_,
+                                              WeightedMoments<state_dim>::size);
+  }
+  const auto first = static_cast<std::uint32_t>(k), second = first + 1;
+  const ParticleSecondStep<Model, MemSpace> next{
+      x_next_, log_weight_next_, dy_next, partials_next_, observation_precision((k + 1) * dt), (k + 1) * dt};
+  run_team_kernel(ParticleTeamPairStep<Model, ExecSpace>{step_data(k * dt, dt, first, dy), next});
+  // The pass's output becomes the bank; its input (step k - 1's particles) stays for the redo.
+  std::swap(x_, x_next_);
+  std::swap(workspace_.cumulative, log_weight_next_);
+  // Step k's posterior. The reference point and log-normalizer stay step k - 1's: both steps of the pass
+  // were taken relative to them.
+  Kokkos::deep_copy(space_, resample_list_size_, 0);
+  run_posterior(partials_, first_, first_log_normalizer_, false);
+  Kokkos::deep_copy(space_, first_.status, status_);
+  // The members step k resamples: copy their step k - 1 particles back, step k, resample, step k + 1.
+  const long copy_items = static_cast<long>(num_members_) * num_particles_;
+  copy_listed_members<state_dim>(
+      space_, CopyListedMembers<state_dim, MemSpace>{x_next_, x_, log_weight_next_, workspace_.cumulative,
+                                                     resample_list_, resample_list_size_, num_particles_,
+                                                     copy_items < listed_copy_items ? copy_items : listed_copy_items});
+  run_team_kernel_listed(ParticleTeamStep<Model, ExecSpace>{step_data(k * dt, dt, first, dy)});
+  resample_listed(first_log_normalizer_, first);
+  ParticleStepData<Model, MemSpace> redo = step_data((k + 1) * dt, dt, second, dy_next);
+  redo.log_normalizer = first_log_normalizer_;  // log N after the resampling
+  redo.partials = partials_next_;
+  run_team_kernel_listed(ParticleTeamStep<Model, ExecSpace>{redo});
+  // Step k + 1's posterior and resampling, as in step().
+  Kokkos::deep_copy(space_, resample_list_size_, 0);
+  run_posterior(partials_next_, current_posterior(), log_normalizer_, true);
+  resample_listed(log_normalizer_, second);
+}
+
+template <class ExecSpace, class Model>
+auto ParticleFilterBank<ExecSpace, Model>::monte_carlo_standard_error() const -> BankVector<MemSpace> {
+  BankVector<MemSpace> se("kushner::particle_mc_se", num_members_, state_dim);
+  parallel_for_members("kushner::particle_mc_se", space_, num_members_,
+                       MonteCarloStandardError<state_dim, MemSpace>{covariance_, ess_, se});
+  return se;
+}
+
+/// The model type the shared instances (engine/shared_instances.hpp) compile the particle filter's classes for:
+/// Model, or NoParticleFilter<Model> where the particle filter does not run it, for which they are empty classes
+/// (nothing compiled for a model no command runs a particle filter on).
+template <class Model>
+struct NoParticleFilter {};
+template <class Model>
+using ParticleInstanceModel =
+    std::conditional_t<particle_filter_unsupported<Model>() == nullptr, Model, NoParticleFilter<Model>>;
+template <class ExecSpace, class Model>
+class ParticleFilterBank<ExecSpace, NoParticleFilter<Model>> {};
+
+#define KUSHNER_SHARED_INSTANCE(Space, Model) \
+  extern template class ParticleFilterBank<Space, ParticleInstanceModel<Model>>;
+KUSHNER_FOR_EACH_SHARED_INSTANCE
+#undef KUSHNER_SHARED_INSTANCE
 
 }  // namespace kushner

@@ -18,17 +18,6 @@
 
 namespace kushner {
 
-/// Largest state dimension of the particle filter: its GPU kernel keeps each thread's weighted moments
-/// (3 + n + n(n+1)/2 doubles) in shared memory, which a 10-state model would overflow.
-constexpr int max_particle_filter_dim = 4;
-
-/// Why the particle filter cannot run Model, or nullptr.
-template <class Model>
-constexpr const char* particle_filter_unsupported() {
-  if (Model::state_dim > max_particle_filter_dim) return "state dimension above 4";
-  return nullptr;
-}
-
 /// When the particle filter takes two steps per call (ParticleFilterBank::step_pair) and the bank scores one
 /// step behind for it: where its kernel fuses the two steps into one pass over the particles (the GPU's), always
 /// (the two steps one after the other where it does not fuse them: the same numbers as `never`, which tests
@@ -73,17 +62,10 @@ class ParticleReference final : public ReferenceEstimator<typename ExecSpace::me
         in_pairs_(takes_step_pairs(settings.step_pairs, pf_.fuses_step_pairs())) {}
 
   std::string name() const override { return particle_filter_name; }
-  void advance(long k, double, double dt, const BankVector<MemSpace>& dy) override {
-    pf_.step(k, dt, dy);
-    accumulate_ess(pf_.effective_sample_size(), pf_.posterior_covariance());
-  }
+  void advance(long k, double, double dt, const BankVector<MemSpace>& dy) override;
   bool advances_in_pairs() const override { return in_pairs_; }
   void advance_pair(long k, double, double dt, const BankVector<MemSpace>& dy,
-                    const BankVector<MemSpace>& dy_next) override {
-    pf_.step_pair(k, dt, dy, dy_next);
-    accumulate_ess(pf_.first_step().ess, pf_.first_step().covariance);
-    accumulate_ess(pf_.effective_sample_size(), pf_.posterior_covariance());
-  }
+                    const BankVector<MemSpace>& dy_next) override;
   EstimateViews<MemSpace> first_of_pair() const override {
     return {pf_.first_step().mean, pf_.first_step().covariance, pf_.first_step().status};
   }
@@ -91,46 +73,11 @@ class ParticleReference final : public ReferenceEstimator<typename ExecSpace::me
   BankSymmetric<MemSpace> covariance() const override { return pf_.posterior_covariance(); }
   BankScalar<Status, MemSpace> status() const override { return pf_.status(); }
 
-  Fields describe() const override {
-    space_.fence();
-    const auto sums = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sums_);
-    const auto resamples = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pf_.resample_count());
-    // Every rank's members in member order (collective::gather), summed in that order: the same bits for any
-    // number of ranks. Resample counts are exact in a double.
-    std::vector<double> local;
-    for (int m = 0; m < pf_.num_members(); ++m)
-      local.insert(local.end(), {sums(m, 0), sums(m, 1), static_cast<double>(resamples(m))});
-    const std::vector<double> all = collective::gather(local);
-    double ess_total = 0.0, squared_error_total = 0.0;
-    long resample_total = 0;
-    const long members = static_cast<long>(all.size()) / 3;
-    for (long m = 0; m < members; ++m) {
-      const double* row = all.data() + 3 * m;
-      if (!std::isfinite(row[0]) || !std::isfinite(row[1])) continue;  // a member that left the numbers
-      ess_total += row[0], squared_error_total += row[1], resample_total += static_cast<long>(row[2]);
-    }
-    const double member_steps = static_cast<double>(members) * steps_;
-    return {{"kind", std::string("particle filter")},
-            {"particles", static_cast<long>(pf_.num_particles())},
-            {"resampling", std::string(to_string(pf_.options().scheme))},
-            {"ess_threshold", pf_.options().ess_threshold},
-            {"precision", std::string(to_string(pf_.options().precision))},
-            {"step_pairs", in_pairs_ ? std::string(pf_.fuses_step_pairs() ? "fused" : "unfused") : std::string("off")},
-            {"mean_ess", steps_ > 0 ? ess_total / member_steps : std::nan("")},
-            {"noise_floor", steps_ > 0 ? std::sqrt(squared_error_total / member_steps) : std::nan("")},
-            {"resamples", resample_total},
-            {"resamples_per_member_step", steps_ > 0 ? resample_total / member_steps : std::nan("")}};
-  }
+  Fields describe() const override;
 
-  std::optional<ParticleSnapshot> particle_snapshot(const std::vector<int>& members) const override {
-    return ParticleSnapshot(pf_, members);
-  }
+  std::optional<ParticleSnapshot> particle_snapshot(const std::vector<int>& members) const override;
 
-  void visit_state(StateArchive& archive) override {
-    pf_.visit_state(archive);
-    archive.view("ess_sums", sums_);
-    archive.value("steps", steps_);
-  }
+  void visit_state(StateArchive& archive) override;
 
   const ParticleFilterBank<ExecSpace, Model>& bank() const { return pf_; }
 
@@ -147,5 +94,73 @@ class ParticleReference final : public ReferenceEstimator<typename ExecSpace::me
   bool in_pairs_;
   long steps_ = 0;
 };
+
+template <class ExecSpace, class Model>
+void ParticleReference<ExecSpace, Model>::advance(long k, double, double dt, const BankVector<MemSpace>& dy) {
+  pf_.step(k, dt, dy);
+  accumulate_ess(pf_.effective_sample_size(), pf_.posterior_covariance());
+}
+
+template <class ExecSpace, class Model>
+void ParticleReference<ExecSpace, Model>::advance_pair(long k, double, double dt, const BankVector<MemSpace>& dy,
+                                                       const BankVector<MemSpace>& dy_next) {
+  pf_.step_pair(k, dt, dy, dy_next);
+  accumulate_ess(pf_.first_step().ess, pf_.first_step().covariance);
+  accumulate_ess(pf_.effective_sample_size(), pf_.posterior_covariance());
+}
+
+template <class ExecSpace, class Model>
+Fields ParticleReference<ExecSpace, Model>::describe() const {
+  space_.fence();
+  const auto sums = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sums_);
+  const auto resamples = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pf_.resample_count());
+  // Every rank's members in member order (collective::gather), summed in that order: the same bits for any
+  // number of ranks. Resample counts are exact in a double.
+  std::vector<double> local;
+  for (int m = 0; m < pf_.num_members(); ++m)
+    local.insert(local.end(), {sums(m, 0), sums(m, 1), static_cast<double>(resamples(m))});
+  const std::vector<double> all = collective::gather(local);
+  double ess_total = 0.0, squared_error_total = 0.0;
+  long resample_total = 0;
+  const long members = static_cast<long>(all.size()) / 3;
+  for (long m = 0; m < members; ++m) {
+    const double* row = all.data() + 3 * m;
+    if (!std::isfinite(row[0]) || !std::isfinite(row[1])) continue;  // a member that left the numbers
+    ess_total += row[0], squared_error_total += row[1], resample_total += static_cast<long>(row[2]);
+  }
+  const double member_steps = static_cast<double>(members) * steps_;
+  return {{"kind", std::string("particle filter")},
+          {"particles", static_cast<long>(pf_.num_particles())},
+          {"resampling", std::string(to_string(pf_.options().scheme))},
+          {"ess_threshold", pf_.options().ess_threshold},
+          {"precision", std::string(to_string(pf_.options().precision))},
+          {"step_pairs", in_pairs_ ? std::string(pf_.fuses_step_pairs() ? "fused" : "unfused") : std::string("off")},
+          {"mean_ess", steps_ > 0 ? ess_total / member_steps : std::nan("")},
+          {"noise_floor", steps_ > 0 ? std::sqrt(squared_error_total / member_steps) : std::nan("")},
+          {"resamples", resample_total},
+          {"resamples_per_member_step", steps_ > 0 ? resample_total / member_steps : std::nan("")}};
+}
+
+template <class ExecSpace, class Model>
+std::optional<ParticleSnapshot> ParticleReference<ExecSpace, Model>::particle_snapshot(
+    const std::vector<int>& members) const {
+  return ParticleSnapshot(pf_, members);
+}
+
+template <class ExecSpace, class Model>
+void ParticleReference<ExecSpace, Model>::visit_state(StateArchive& archive) {
+  pf_.visit_state(archive);
+  archive.view("ess_sums", sums_);
+  archive.value("steps", steps_);
+}
+
+/// A model the particle filter does not run has no shared ParticleReference (ParticleInstanceModel).
+template <class ExecSpace, class Model>
+class ParticleReference<ExecSpace, NoParticleFilter<Model>> {};
+
+#define KUSHNER_SHARED_INSTANCE(Space, Model) \
+  extern template class ParticleReference<Space, ParticleInstanceModel<Model>>;
+KUSHNER_FOR_EACH_SHARED_INSTANCE
+#undef KUSHNER_SHARED_INSTANCE
 
 }  // namespace kushner

@@ -30,12 +30,14 @@ cat "$out/gpu.csv" "$out/mpirun.txt"
 
 if want build; then
   log "configure"
+  # The models' banks and commands spread over more units than the default: the GPU machines have 16-32 cores.
   cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON -DKUSHNER_ENABLE_OPENMP=ON \
     -DKUSHNER_ENABLE_MPI=ON -DKUSHNER_ENABLE_TESTS=OFF -DKUSHNER_ENABLE_BENCHMARKS=OFF \
+    -DKUSHNER_INSTANCE_UNITS=16 -DKUSHNER_COMMAND_UNITS=8 \
     > "$out/configure.log" 2>&1 || { tail -20 "$out/configure.log"; exit 1; }
   grep "mpi=" "$out/configure.log"
   log "build kushner"
-  cmake --build "$build" -j16 --target kushner > "$out/build.log" 2>&1 ||
+  cmake --build "$build" -j "$(nproc)" --target kushner > "$out/build.log" 2>&1 ||
     { grep -B2 -A12 -m3 "error" "$out/build.log"; exit 1; }
   log "built"
 fi
@@ -68,6 +70,8 @@ if want run; then
   run strong_r1_m2000 1 2000
   strong_r2=weak_r2_m2000  # the same run: M = 2000 on 2 ranks
   kill "$sampler" 2>/dev/null
+  # Anything Kokkos or CUDA wrote to the terminal (a run should print nothing but its result line with --quiet).
+  grep -il "error\|warning" "$out"/weak_*.log "$out"/strong_*.log 2>/dev/null | sed 's/^/messages in: /'
   python3 - "$out" "$gpus" "$strong_r2" "$T" <<'PY' | tee "$out/summary.txt" || status=1
 import json, math, os, sys
 out, gpus, strong_r2 = sys.argv[1], int(sys.argv[2]), sys.argv[3]
@@ -80,6 +84,11 @@ print(f"weak:   M = 1000 on 1 rank {w1:.2f} s, M = 2000 on 2 ranks {w2:.2f} s: e
 print(f"strong: M = 2000 on 1 rank {s1:.2f} s, on 2 ranks {s2:.2f} s: speedup {s1 / s2:.3f} (goal >= 1.8)")
 for name, m, secs in (("1 rank, M = 1000", 1000, w1), ("1 rank, M = 2000", 2000, s1), ("2 ranks, M = 2000", 2000, s2)):
     print(f"  {name}: {m * particles * steps / secs:.3g} particle-steps/s end to end")
+# The step loop alone (summary.json's timing, rank 0's; start-up, Kokkos initialization and outputs left out).
+loop = lambda name: json.load(open(os.path.join(out, name, "summary.json")))["timing"]["step_loop_s"]
+l_w1, l_s1, l_s2 = loop("weak_r1_m1000"), loop("strong_r1_m2000"), loop(strong_r2)
+print(f"step loop: M = 1000 on 1 rank {l_w1:.3f} s, M = 2000 on 1 rank {l_s1:.3f} s, on 2 ranks {l_s2:.3f} s: "
+      f"weak efficiency {l_w1 / l_s2:.3f}, strong speedup {l_s1 / l_s2:.3f}")
 
 def numbers(path):  # every number of timeseries.csv, row by row
     rows = [l.rstrip("\n").split(",") for l in open(path) if not l.startswith("#")]
@@ -98,7 +107,7 @@ sa, sb = (json.load(open(os.path.join(d, "summary.json"))) for d in (a_dir, b_di
 def flat(j, prefix=""):
     if isinstance(j, dict):
         for k, v in j.items():
-            if k not in ("backend", "command"):
+            if k not in ("backend", "command", "timing"):
                 yield from flat(v, prefix + "." + k)
     elif isinstance(j, (int, float)) and not isinstance(j, bool):
         yield prefix, float(j)

@@ -107,11 +107,15 @@ MemberErrors run_against_reference(const Model& model, const std::vector<std::st
                                    const std::string& perturb_towards = "", double weight = 0.0) {
   FilterBank<Space, Model> bank(Space(), model, model, spec.members, spec.seed, filters);
   std::unique_ptr<ReferenceEstimator<MemSpace>> base;
-  if (spec.particles > 0) {
-    ParticleSettings settings;
-    settings.particles = static_cast<int>(spec.particles);
-    base = std::make_unique<ParticleReference<Space, Model>>(Space(), model, spec.members, spec.seed, settings);
-  } else {
+  if constexpr (particle_filter_unsupported<Model>() == nullptr) {
+    if (spec.particles > 0) {
+      ParticleSettings settings;
+      settings.particles = static_cast<int>(spec.particles);
+      base = std::make_unique<ParticleReference<Space, Model>>(Space(), model, spec.members, spec.seed, settings);
+    }
+  }
+  if (!base) {
+    KUSHNER_REQUIRE(spec.particles == 0, Model::name << " has no particle filter: set particles = 0");
     base = std::make_unique<TruthReference>(bank.truths().state());
   }
   std::unique_ptr<PerturbedReference> perturbed;

@@ -25,6 +25,8 @@ sanitize=${KUSHNER_SANITIZE:-address,undefined}
 jobs=${KUSHNER_JOBS:-$(nproc)}
 configure=(-DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_CXX_FLAGS_SANITIZE="${SANITIZE_OPT:--O1} -g" -DKUSHNER_SANITIZE="$sanitize"
            -DKUSHNER_ENABLE_CUDA=OFF -DKUSHNER_ENABLE_BENCHMARKS=OFF)
+# A few targets compile only the banks they run; the whole suite shares each model's banks (engine/shared_instances.hpp).
+if [ -n "${SANITIZE_TARGETS:-}" ]; then configure+=(-DKUSHNER_SHARED_INSTANCES=OFF); else configure+=(-DKUSHNER_SHARED_INSTANCES=ON); fi
 if [[ "$sanitize" == *thread* ]]; then
   archer=/usr/lib/llvm-14/lib/libarcher.so
   [ -e "$archer" ] || { echo "sanitize: ThreadSanitizer needs $archer (Debian: apt-get install clang-14 libomp-14-dev)" >&2; exit 2; }

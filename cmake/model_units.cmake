@@ -1,0 +1,31 @@
+# kushner_model_units(<template> <name> <count> <out_var> <macro>...): spreads the models of models/model_list.hpp
+# over <count> generated translation units, round robin, so that what is compiled per model compiles in parallel
+# and once. Each unit is <template> with @KUSHNER_UNIT_INSTANTIATIONS@ replaced by `<macro>(Model)` for each macro
+# and each of its models; the files are ${CMAKE_BINARY_DIR}/generated/<name>_<i>.cpp, listed in <out_var>. A model
+# added to the list is compiled without any edit here.
+function(kushner_model_units template name count out_var)
+  file(READ ${CMAKE_SOURCE_DIR}/models/model_list.hpp model_list)
+  string(REGEX MATCHALL "\n *(MODEL|DISCRETE_MODEL|FILE_MODEL)\\([^)]*\\)" model_lines "${model_list}")
+  set_property(DIRECTORY APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/models/model_list.hpp ${template})
+  math(EXPR last_unit "${count} - 1")
+  foreach(unit RANGE ${last_unit})
+    set(unit_body_${unit} "")
+  endforeach()
+  set(model_index 0)
+  foreach(line IN LISTS model_lines)
+    string(REGEX REPLACE "^\n *(MODEL|DISCRETE_MODEL|FILE_MODEL)\\(([^)]*)\\)$" "\\2" model "${line}")
+    math(EXPR unit "${model_index} % ${count}")
+    foreach(macro IN LISTS ARGN)
+      string(APPEND unit_body_${unit} "${macro}(${model})\n")
+    endforeach()
+    math(EXPR model_index "${model_index} + 1")
+  endforeach()
+  set(files "")
+  foreach(unit RANGE ${last_unit})
+    set(KUSHNER_UNIT_INSTANTIATIONS "${unit_body_${unit}}")
+    set(file ${CMAKE_BINARY_DIR}/generated/${name}_${unit}.cpp)
+    configure_file(${template} ${file} @ONLY)
+    list(APPEND files ${file})
+  endforeach()
+  set(${out_var} ${files} PARENT_SCOPE)
+endfunction()
