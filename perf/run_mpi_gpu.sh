@@ -70,8 +70,10 @@ if want run; then
   run strong_r1_m2000 1 2000
   strong_r2=weak_r2_m2000  # the same run: M = 2000 on 2 ranks
   kill "$sampler" 2>/dev/null
-  # Anything Kokkos or CUDA wrote to the terminal (a run should print nothing but its result line with --quiet).
-  grep -il "error\|warning" "$out"/weak_*.log "$out"/strong_*.log 2>/dev/null | sed 's/^/messages in: /'
+  # Anything Kokkos or CUDA wrote besides Kokkos 3.4's note that it knows no Hopper (the sm_90 code is there).
+  for f in "$out"/weak_*.log "$out"/strong_*.log; do
+    grep -iv "compiled for compute capability 8.0" "$f" | grep -i "error\|warning" | sed "s|^|$(basename "$f"): |"
+  done
   python3 - "$out" "$gpus" "$strong_r2" "$T" <<'PY' | tee "$out/summary.txt" || status=1
 import json, math, os, sys
 out, gpus, strong_r2 = sys.argv[1], int(sys.argv[2]), sys.argv[3]

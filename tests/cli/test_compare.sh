@@ -55,9 +55,11 @@ width = float(pf[1]["x"]) - float(pf[0]["x"])
 assert abs(sum(float(r["density"]) for r in pf) * width - 1) < 0.01, "PF histogram does not integrate to ~1"
 assert "rmse_ref" in open(os.path.join(d, "report.md")).read()
 # The banks' bytes: the sine model (n = 1) with systematic resampling keeps per particle its state and scratch
-# copy (2 x 8 B), its log-weight (8 B) and ancestor (4 B).
+# copy (2 x 8 B), its log-weight (8 B) and ancestor (4 B); where step pairs are fused (a GPU's default), also the
+# second bank's state and log-weight (16 B).
 mem = s["memory"]
-assert mem["particle_bytes_per_particle"] == 28, mem
+fused = s["reference"]["step_pairs"] == "fused"
+assert mem["particle_bytes_per_particle"] == (44 if fused else 28), (mem, s["reference"]["step_pairs"])
 assert mem["total_bytes"] > 12 * 256 * 28 and mem["bank_bytes_per_member"] > 0, mem
 assert "- memory: " in open(os.path.join(d, "report.md")).read()
 PY
