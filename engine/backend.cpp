@@ -46,7 +46,7 @@ std::vector<std::string> available_backends() {
 #if defined(KOKKOS_ENABLE_OPENMP)
   names.emplace_back("openmp");
 #endif
-#if defined(KOKKOS_ENABLE_SERIAL)
+#if defined(KUSHNER_RUNS_SERIAL)
   names.emplace_back("serial");
 #endif
   return names;

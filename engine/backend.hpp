@@ -11,6 +11,13 @@
 #include <type_traits>
 #include <vector>
 
+// The serial backend, where Kokkos has it; not in CI's CUDA compile check (KUSHNER_CUDA_COMPILE_CHECK), which
+// compiles the commands for the GPU alone: the host backends' code is the host build's, and leaving it out there
+// saved a quarter of each unit's compile (instance_unit_0: 58.9 -> 45.1 s).
+#if defined(KOKKOS_ENABLE_SERIAL) && !defined(KUSHNER_CUDA_COMPILE_CHECK)
+#define KUSHNER_RUNS_SERIAL
+#endif
+
 namespace kushner {
 
 /// Backends compiled into this binary, default first.
@@ -43,7 +50,7 @@ void with_backend_type(const std::string& name, F&& f) {
 #if defined(KOKKOS_ENABLE_OPENMP)
   if (name == "openmp") return f(static_cast<Kokkos::OpenMP*>(nullptr));
 #endif
-#if defined(KOKKOS_ENABLE_SERIAL)
+#if defined(KUSHNER_RUNS_SERIAL)
   if (name == "serial") return f(static_cast<Kokkos::Serial*>(nullptr));
 #endif
   KUSHNER_REQUIRE(false, "backend '" << name << "' is not compiled in");

@@ -520,16 +520,12 @@ auto ParticleFilterBank<ExecSpace, Model>::monte_carlo_standard_error() const ->
   return se;
 }
 
-/// The model type the shared instances (engine/shared_instances.hpp) compile the particle filter's classes for:
-/// Model, or NoParticleFilter<Model> where the particle filter does not run it, for which they are empty classes
-/// (nothing compiled for a model no command runs a particle filter on).
+/// The model type the shared instances compile the particle filter's classes for (SharedModel,
+/// engine/shared_instances.hpp): Model, or NotShared<Model> above the particle filter's largest dimension.
 template <class Model>
-struct NoParticleFilter {};
-template <class Model>
-using ParticleInstanceModel =
-    std::conditional_t<particle_filter_unsupported<Model>() == nullptr, Model, NoParticleFilter<Model>>;
+using ParticleInstanceModel = SharedModel<Model, particle_filter_unsupported<Model>() == nullptr>;
 template <class ExecSpace, class Model>
-class ParticleFilterBank<ExecSpace, NoParticleFilter<Model>> {};
+class ParticleFilterBank<ExecSpace, NotShared<Model>> {};
 
 #define KUSHNER_SHARED_INSTANCE(Space, Model) \
   extern template class ParticleFilterBank<Space, ParticleInstanceModel<Model>>;

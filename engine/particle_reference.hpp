@@ -156,7 +156,7 @@ void ParticleReference<ExecSpace, Model>::visit_state(StateArchive& archive) {
 
 /// A model the particle filter does not run has no shared ParticleReference (ParticleInstanceModel).
 template <class ExecSpace, class Model>
-class ParticleReference<ExecSpace, NoParticleFilter<Model>> {};
+class ParticleReference<ExecSpace, NotShared<Model>> {};
 
 #define KUSHNER_SHARED_INSTANCE(Space, Model) \
   extern template class ParticleReference<Space, ParticleInstanceModel<Model>>;

@@ -11,6 +11,7 @@
 #include "core/options.hpp"
 #include "engine/filter_bank.hpp"
 #include "engine/particle_reference.hpp"
+#include "engine/shared_instances.hpp"
 #include "engine/time_grid.hpp"
 #include "engine/truth_bank.hpp"
 #include "kernels/control/closed_loop_step.hpp"
@@ -54,68 +55,14 @@ class ControlLoop {
   /// `estimator`: state_estimator_name, a filter the model supports, or particle_filter_name.
   ControlLoop(const ExecSpace& space, const Model& model, long members, Seed seed, const std::string& estimator,
               const ControlLaw<n, m, MemSpace>& law, const QuadraticCost<n, m>& cost, const OptionValues& options = {},
-              const ParticleSettings& particle = {}, const PreparedFilters& prepared = {})
-      : space_(space),
-        model_(model),
-        members_(members),
-        seed_(seed),
-        estimator_(estimator),
-        law_(law),
-        cost_(cost),
-        truths_(space, model, members, seed),
-        truth_status_("kushner::loop_truth_status", members),
-        control_("kushner::loop_control", members, m),
-        totals_("kushner::loop_totals", members, num_loop_columns) {
-    if (estimator == particle_filter_name) {
-      if constexpr (particle_filter_unsupported<Model>() == nullptr) {
-        pf_ = std::make_unique<ParticleFilterBank<ExecSpace, Model>>(space, model, static_cast<int>(members),
-                                                                     particle.particles, seed, particle.options);
-        source_ = EstimateSource::outside;
-      }
-      KUSHNER_REQUIRE(pf_ != nullptr, "ControlLoop: no particle filter for model " << Model::name);
-    } else if (estimator != state_estimator_name) {
-      bool found = false;
-      for_each_slot([&](auto& slot) {
-        using Filter = decltype(slot.filter);
-        if (estimator != Filter::name) return;
-        found = true;
-        enable_filter_slot(slot, model, members, options, std::get<std::optional<Filter>>(prepared), seed);
-      });
-      KUSHNER_REQUIRE(found, "ControlLoop: filter '" << estimator << "' is not supported by model " << Model::name);
-      source_ = EstimateSource::bank_filter;
-    }
-  }
+              const ParticleSettings& particle = {}, const PreparedFilters& prepared = {});
 
   /// Step k over [k dt, (k + 1) dt]; `record`: (k + 1) dt is an output time.
-  void step(long k, double dt, bool record) {
-    typename K::Step kernel;
-    kernel.truth = TruthStep<Model, MemSpace>{model_, truths_.state(), truths_.observations(),       k * dt,
-                                              dt,     seed_,           static_cast<std::uint32_t>(k)};
-    kernel.model = model_;
-    kernel.truth_status = truth_status_;
-    kernel.slots = slots_;
-    kernel.source = source_;
-    if (pf_) kernel.outside_estimate = pf_->posterior_mean();
-    kernel.law = law_;
-    kernel.cost = cost_;
-    kernel.control = control_;
-    kernel.totals = totals_;
-    kernel.step = k;
-    kernel.record = record;
-    parallel_for_members("kushner::closed_loop_step", space_, members_, kernel);
-    if (pf_) pf_->step(k, dt, truths_.observations(), control_);
-  }
+  void step(long k, double dt, bool record);
 
   /// Each member's cost over the run (call after the last step): running plus terminal; NaN where the truth
   /// escaped to infinity.
-  std::vector<double> member_costs() const {
-    BankScalar<double, MemSpace> cost("kushner::loop_cost", members_);
-    parallel_for_members("kushner::closed_loop_terminal", space_, members_,
-                         ClosedLoopTerminal<Model, MemSpace>{truths_.state(), truth_status_, cost_, totals_, cost});
-    space_.fence();
-    const auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), cost);
-    return std::vector<double>(h.data(), h.data() + members_);
-  }
+  std::vector<double> member_costs() const;
 
   /// Each member's control energy, the integral of |u|^2 dt so far.
   std::vector<double> member_control_energy() const { return host_column(totals_, loop_control_energy); }
@@ -137,24 +84,11 @@ class ControlLoop {
   }
 
   /// Per member: whether its truth and its estimator are still finite and well defined.
-  std::vector<char> members_ok() const {
-    std::vector<char> ok(members_, 0);
-    space_.fence();
-    const auto truth = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), truth_status_);
-    const auto status = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), estimator_status());
-    for (long member = 0; member < members_; ++member)
-      ok[member] = truth(member) == Status::ok && (status.extent(0) == 0 || status(member) == Status::ok);
-    return ok;
-  }
+  std::vector<char> members_ok() const;
 
   /// Members whose truth escaped to infinity, and members whose estimator diverged (their truth did not).
   long truths_escaped() const { return count_status(space_, truth_status_, Status::non_finite); }
-  long estimator_diverged() const {
-    const BankScalar<Status, MemSpace> status = estimator_status();
-    if (status.extent(0) == 0) return 0;
-    return count_status(space_, status, Status::not_positive_definite, truth_status_) +
-           count_status(space_, status, Status::non_finite, truth_status_);
-  }
+  long estimator_diverged() const;
 
   /// What the estimator adds to the summary (a bank filter's summary fields; the particle filter's settings).
   Fields estimator_fields() const {
@@ -223,5 +157,101 @@ class ControlLoop {
   EstimateSource source_ = EstimateSource::state;
   std::unique_ptr<ParticleFilterBank<ExecSpace, Model>> pf_;
 };
+
+template <class ExecSpace, class Model>
+ControlLoop<ExecSpace, Model>::ControlLoop(const ExecSpace& space, const Model& model, long members, Seed seed,
+                                           const std::string& estimator, const ControlLaw<n, m, MemSpace>& law,
+                                           const QuadraticCost<n, m>& cost, const OptionValues& options,
+                                           const ParticleSettings& particle, const PreparedFilters& prepared)
+    : space_(space),
+      model_(model),
+      members_(members),
+      seed_(seed),
+      estimator_(estimator),
+      law_(law),
+      cost_(cost),
+      truths_(space, model, members, seed),
+      truth_status_("kushner::loop_truth_status", members),
+      control_("kushner::loop_control", members, m),
+      totals_("kushner::loop_totals", members, num_loop_columns) {
+  if (estimator == particle_filter_name) {
+    if constexpr (particle_filter_unsupported<Model>() == nullptr) {
+      pf_ = std::make_unique<ParticleFilterBank<ExecSpace, Model>>(space, model, static_cast<int>(members),
+                                                                   particle.particles, seed, particle.options);
+      source_ = EstimateSource::outside;
+    }
+    KUSHNER_REQUIRE(pf_ != nullptr, "ControlLoop: no particle filter for model " << Model::name);
+  } else if (estimator != state_estimator_name) {
+    bool found = false;
+    for_each_slot([&](auto& slot) {
+      using Filter = decltype(slot.filter);
+      if (estimator != Filter::name) return;
+      found = true;
+      enable_filter_slot(slot, model, members, options, std::get<std::optional<Filter>>(prepared), seed);
+    });
+    KUSHNER_REQUIRE(found, "ControlLoop: filter '" << estimator << "' is not supported by model " << Model::name);
+    source_ = EstimateSource::bank_filter;
+  }
+}
+
+template <class ExecSpace, class Model>
+void ControlLoop<ExecSpace, Model>::step(long k, double dt, bool record) {
+  typename K::Step kernel;
+  kernel.truth = TruthStep<Model, MemSpace>{model_, truths_.state(), truths_.observations(),       k * dt,
+                                            dt,     seed_,           static_cast<std::uint32_t>(k)};
+  kernel.model = model_;
+  kernel.truth_status = truth_status_;
+  kernel.slots = slots_;
+  kernel.source = source_;
+  if (pf_) kernel.outside_estimate = pf_->posterior_mean();
+  kernel.law = law_;
+  kernel.cost = cost_;
+  kernel.control = control_;
+  kernel.totals = totals_;
+  kernel.step = k;
+  kernel.record = record;
+  parallel_for_members("kushner::closed_loop_step", space_, members_, kernel);
+  if (pf_) pf_->step(k, dt, truths_.observations(), control_);
+}
+
+template <class ExecSpace, class Model>
+std::vector<double> ControlLoop<ExecSpace, Model>::member_costs() const {
+  BankScalar<double, MemSpace> cost("kushner::loop_cost", members_);
+  parallel_for_members("kushner::closed_loop_terminal", space_, members_,
+                       ClosedLoopTerminal<Model, MemSpace>{truths_.state(), truth_status_, cost_, totals_, cost});
+  space_.fence();
+  const auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), cost);
+  return std::vector<double>(h.data(), h.data() + members_);
+}
+
+template <class ExecSpace, class Model>
+std::vector<char> ControlLoop<ExecSpace, Model>::members_ok() const {
+  std::vector<char> ok(members_, 0);
+  space_.fence();
+  const auto truth = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), truth_status_);
+  const auto status = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), estimator_status());
+  for (long member = 0; member < members_; ++member)
+    ok[member] = truth(member) == Status::ok && (status.extent(0) == 0 || status(member) == Status::ok);
+  return ok;
+}
+
+template <class ExecSpace, class Model>
+long ControlLoop<ExecSpace, Model>::estimator_diverged() const {
+  const BankScalar<Status, MemSpace> status = estimator_status();
+  if (status.extent(0) == 0) return 0;
+  return count_status(space_, status, Status::not_positive_definite, truth_status_) +
+         count_status(space_, status, Status::non_finite, truth_status_);
+}
+
+/// The model type the shared instances compile ControlLoop for (SharedModel, engine/shared_instances.hpp): Model, or
+/// NotShared<Model> for a model without a control input.
+template <class Model>
+using ControlLoopInstanceModel = SharedModel<Model, ModelTraits<Model>::controlled>;
+template <class ExecSpace, class Model>
+class ControlLoop<ExecSpace, NotShared<Model>> {};
+
+#define KUSHNER_SHARED_INSTANCE(Space, Model) extern template class ControlLoop<Space, ControlLoopInstanceModel<Model>>;
+KUSHNER_FOR_EACH_SHARED_INSTANCE
+#undef KUSHNER_SHARED_INSTANCE
 
 }  // namespace kushner
