@@ -80,6 +80,31 @@ void enable_filter_slot(FilterSlot<Filter, MemSpace>& slot, const Model& model, 
   Kokkos::deep_copy(slot.P, Ph);
 }
 
+/// Calls f with each filter's slot of `slots` (host side: what is selected, its views, its summary).
+template <class F, class MemSpace, class... Filters>
+void for_each_filter_slot(FilterSlots<MemSpace, Filters...>& slots, F&& f) {
+  (f(static_cast<FilterSlot<Filters, MemSpace>&>(slots)), ...);
+}
+template <class F, class MemSpace, class... Filters>
+void for_each_filter_slot(const FilterSlots<MemSpace, Filters...>& slots, F&& f) {
+  (f(static_cast<const FilterSlot<Filters, MemSpace>&>(slots)), ...);
+}
+
+/// Enables the slot of the filter called `name` (enable_filter_slot, with its pre-pass's filter where `prepared`
+/// has one); false when no slot has that name (the caller says why in its own words).
+template <class Slots, class Prepared, class Model>
+bool enable_named_filter_slot(Slots& slots, const std::string& name, const Model& model, long members,
+                              const OptionValues& options, const Prepared& prepared, Seed seed) {
+  bool found = false;
+  for_each_filter_slot(slots, [&](auto& slot) {
+    using Filter = decltype(slot.filter);
+    if (name != Filter::name) return;
+    found = true;
+    enable_filter_slot(slot, model, members, options, std::get<std::optional<Filter>>(prepared), seed);
+  });
+  return found;
+}
+
 /// `TruthModel`: the truths' model type, Model unless the truths follow another system of the same dimensions
 /// (kernels/filters/filter_bank_step.hpp).
 template <class ExecSpace, class Model, class TruthModel = Model>
@@ -235,19 +260,11 @@ class FilterBank {
  private:
   template <class F>
   void for_each_slot(F&& f) {
-    for_each_slot_impl(f, static_cast<SupportedFilters<Model, MemSpace>*>(nullptr));
+    for_each_filter_slot(slots_, f);
   }
   template <class F>
   void for_each_slot(F&& f) const {
-    for_each_slot_impl(f, static_cast<SupportedFilters<Model, MemSpace>*>(nullptr));
-  }
-  template <class F, class... Filters>
-  void for_each_slot_impl(F& f, std::tuple<Filters...>*) {
-    (f(static_cast<FilterSlot<Filters, MemSpace>&>(slots_)), ...);
-  }
-  template <class F, class... Filters>
-  void for_each_slot_impl(F& f, std::tuple<Filters...>*) const {
-    (f(static_cast<const FilterSlot<Filters, MemSpace>&>(slots_)), ...);
+    for_each_filter_slot(slots_, f);
   }
 
   struct Estimator {
@@ -397,16 +414,9 @@ FilterBank<ExecSpace, Model, TruthModel>::FilterBank(const ExecSpace& space, con
       seed_(seed),
       truths_(space, truth_model, members, seed),
       truth_status_("kushner::truth_status", members) {
-  for (const auto& name : filters) {
-    bool found = false;
-    for_each_slot([&](auto& slot) {
-      using Filter = decltype(slot.filter);
-      if (name != Filter::name) return;
-      found = true;
-      enable_filter_slot(slot, filter_model, members, options, std::get<std::optional<Filter>>(prepared), seed);
-    });
-    KUSHNER_REQUIRE(found, "filter '" << name << "' is not supported by model " << Model::name);
-  }
+  for (const auto& name : filters)
+    KUSHNER_REQUIRE(enable_named_filter_slot(slots_, name, filter_model, members, options, prepared, seed),
+                    "filter '" << name << "' is not supported by model " << Model::name);
   parallel_for_members("kushner::filter_bank_initial_score", space_, members_,
                        typename K::Initial{truths_.state(), slots_});
 }

@@ -111,19 +111,11 @@ class ControlLoop {
  private:
   template <class F>
   void for_each_slot(F&& f) {
-    for_each_slot_impl(f, static_cast<SupportedFilters<Model, MemSpace>*>(nullptr));
+    for_each_filter_slot(slots_, f);
   }
   template <class F>
   void for_each_slot(F&& f) const {
-    for_each_slot_impl(f, static_cast<SupportedFilters<Model, MemSpace>*>(nullptr));
-  }
-  template <class F, class... Filters>
-  void for_each_slot_impl(F& f, std::tuple<Filters...>*) {
-    (f(static_cast<FilterSlot<Filters, MemSpace>&>(slots_)), ...);
-  }
-  template <class F, class... Filters>
-  void for_each_slot_impl(F& f, std::tuple<Filters...>*) const {
-    (f(static_cast<const FilterSlot<Filters, MemSpace>&>(slots_)), ...);
+    for_each_filter_slot(slots_, f);
   }
 
   BankScalar<Status, MemSpace> estimator_status() const {
@@ -182,14 +174,8 @@ ControlLoop<ExecSpace, Model>::ControlLoop(const ExecSpace& space, const Model& 
     }
     KUSHNER_REQUIRE(pf_ != nullptr, "ControlLoop: no particle filter for model " << Model::name);
   } else if (estimator != state_estimator_name) {
-    bool found = false;
-    for_each_slot([&](auto& slot) {
-      using Filter = decltype(slot.filter);
-      if (estimator != Filter::name) return;
-      found = true;
-      enable_filter_slot(slot, model, members, options, std::get<std::optional<Filter>>(prepared), seed);
-    });
-    KUSHNER_REQUIRE(found, "ControlLoop: filter '" << estimator << "' is not supported by model " << Model::name);
+    KUSHNER_REQUIRE(enable_named_filter_slot(slots_, estimator, model, members, options, prepared, seed),
+                    "ControlLoop: filter '" << estimator << "' is not supported by model " << Model::name);
     source_ = EstimateSource::bank_filter;
   }
 }

@@ -9,6 +9,11 @@ run_kushner() {
   rc=$?
   set -e
 }
+# built_backends: the backends $kushner was built with, from its --version line (e.g. "serial openmp").
+built_backends() { "$kushner" --version | sed -n 's/^available backends: \(.*\) (select.*/\1/p'; }
+# host_backend: where the bit-for-bit comparisons run: openmp where built, else serial (a GPU's math library differs
+# from the host's in the last bits, so a CUDA build's default backend is compared to a tolerance elsewhere).
+host_backend() { if grep -qw openmp <<<"$(built_backends)"; then echo openmp; else echo serial; fi; }
 # can_draw_figures: whether the interpreter kushner plots with (drivers/plots.cpp: $KUSHNER_PYTHON, else
 # /usr/bin/python3, else python3) has matplotlib; sets $plot_python to it.
 can_draw_figures() {

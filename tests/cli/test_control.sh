@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# `kushner control`: artefacts, the same bytes on 1 and 2 threads and on Serial, every controller's entry in
+# `kushner control`: artefacts, the same bytes on 1 and 2 threads and on Serial (host backends: host_backend in
+# lib.sh; a CUDA build's default is left to tests/cli/test_filter_determinism.sh's tolerance), every controller's entry in
 # summary.json, the HJB reference below the controllers, and bad input refused with one line, exit 2, nothing
 # written.
 set -euo pipefail
@@ -10,15 +11,16 @@ trap 'rm -rf "$work"' EXIT
 python=/usr/bin/python3
 [ -x "$python" ] || python=python3
 
+host=$(host_backend)
 args=(control --model sine --members 300 --T 1 --dt 1e-2 --particles 128 --seed 4
       --controllers NONE@state,LQR@state,LQR@EKF,LQR@PF,ASRE@ASRE,HJB@state --cost Q=1 --cost F=2 --cost R=0.5)
-OMP_NUM_THREADS=2 run_kushner "$work/a" "${args[@]}" --out "$work/a" --quiet
+KUSHNER_BACKEND=$host OMP_NUM_THREADS=2 run_kushner "$work/a" "${args[@]}" --out "$work/a" --quiet
 [ "$rc" -eq 0 ] || fail "control failed: $(cat "$work/a.err")"
 for f in summary.json timeseries.csv report.md; do [ -s "$work/a/$f" ] || fail "control did not write $f"; done
 if can_draw_figures; then
   for f in control_paths ranking running_cost; do [ -s "$work/a/$f.png" ] || fail "control did not draw $f.png"; done
 fi
-OMP_NUM_THREADS=1 run_kushner "$work/b" "${args[@]}" --out "$work/b" --quiet --no-plots
+KUSHNER_BACKEND=$host OMP_NUM_THREADS=1 run_kushner "$work/b" "${args[@]}" --out "$work/b" --quiet --no-plots
 [ "$rc" -eq 0 ] || fail "control (1 thread) failed: $(cat "$work/b.err")"
 # Line 1 is the comment with the command (its --out differs); every number after it must be the same.
 cmp -s <(tail -n +2 "$work/a/timeseries.csv") <(tail -n +2 "$work/b/timeseries.csv") ||
@@ -26,7 +28,7 @@ cmp -s <(tail -n +2 "$work/a/timeseries.csv") <(tail -n +2 "$work/b/timeseries.c
 KUSHNER_BACKEND=serial run_kushner "$work/c" "${args[@]}" --out "$work/c" --quiet --no-plots
 [ "$rc" -eq 0 ] || fail "control (serial) failed: $(cat "$work/c.err")"
 cmp -s <(tail -n +2 "$work/a/timeseries.csv") <(tail -n +2 "$work/c/timeseries.csv") ||
-  fail "timeseries.csv differs between OpenMP and Serial"
+  fail "timeseries.csv differs between $host and serial"
 
 "$python" - "$work/a/summary.json" "$work/b/summary.json" <<'PY' || fail "summary.json checks failed"
 import json, math, sys

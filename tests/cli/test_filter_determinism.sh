@@ -18,7 +18,7 @@ run_as() {  # run_as NAME ENV... -- ARGS...: run into $work/out (the same --out 
 compare_runs() {
   local name=$1; shift
   local backends
-  backends=$("$kushner" --version | sed -n 's/^available backends: \(.*\) (select.*/\1/p')
+  backends=$(built_backends)
   run_as "$name-serial" KUSHNER_BACKEND=serial -- "$@"
   if grep -qw openmp <<<"$backends"; then
     run_as "$name-omp1" OMP_NUM_THREADS=1 KUSHNER_BACKEND=openmp -- "$@"

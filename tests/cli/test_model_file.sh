@@ -19,8 +19,9 @@ trap 'chmod -R u+w "$work"; rm -rf "$work"' EXIT
 
 # Bit for bit holds on the host backends (CPU builds compile with -ffp-contract=off); a GPU contracts a*b+c into
 # FMAs wherever nvcc sees the pattern, which the built-in and the file model offer in different places.
-backends=$("$kushner" --version | sed -n 's/^available backends: \(.*\) (select.*/\1/p')
-if grep -qw openmp <<<"$backends"; then export KUSHNER_BACKEND=openmp; else export KUSHNER_BACKEND=serial; fi
+backends=$(built_backends)
+KUSHNER_BACKEND=$(host_backend)
+export KUSHNER_BACKEND
 
 # Compares two timeseries.csv files (simulate's truths): the largest relative difference, at most 1e-12.
 compare_timeseries() {  # compare_timeseries A B
