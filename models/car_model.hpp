@@ -26,7 +26,9 @@ struct CarBase : InitialLaw<2> {
 
   double v = 1.0, l = 1.0, u = 0.05, q = 0.0, r = 1.0;
 
-  CarBase() {
+  // Device-callable: nvcc takes the cars' implicit constructors for __host__ __device__ and warned (#20011-D, in
+  // every CUDA unit with a car) that they called this one while it was host-only.
+  KOKKOS_INLINE_FUNCTION CarBase() {
     x0_mean = Vec<2>::zero();
     x0_cov = Mat<2, 2>::zero();
     prior_mean = Vec<2>{{10.0, 0.1}};
