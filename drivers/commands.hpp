@@ -1,6 +1,6 @@
 #pragma once
 // The subcommands of `kushner`. Each validates all its input before opening any output and throws
-// InputError for bad input; main() turns that into one line on stderr and exit code 2.
+// InputError for bad input; command_line_main() turns that into one line on stderr and exit code 2.
 #include "drivers/checkpoint_file.hpp"
 #include "drivers/control_options.hpp"
 #include "drivers/filter_options.hpp"

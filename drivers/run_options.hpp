@@ -24,7 +24,7 @@ struct RunOptions {
   int output_points = 200;
   bool output_points_given = false;  // --output-points was given (the default is capped at the steps quietly)
   bool quiet = false;
-  std::string config;  // --config FILE, already expanded into the fields above by main()
+  std::string config;  // --config FILE, already expanded into the fields above by the command line (command_line.cpp)
 };
 
 /// --model, --model-file, --set, --members, --T, --dt, --seed, --out, --output-points, --quiet, --config.

@@ -180,14 +180,18 @@ struct Poly3Passes {
     const bool car_form =
         options.reading == Poly3Reading::printed_car_eq23 || options.reading == Poly3Reading::printed_car_eq11;
     if (car_form) {
-      KUSHNER_INPUT_REQUIRE(n == 2 && m == 1, "POLY3 " << poly3_reading_name(options.reading)
-                                                       << ": Basin's car equations need 2 states and 1 control");
-      KUSHNER_INPUT_REQUIRE(Qc.cwiseAbs().maxCoeff() == 0.0 && std::fabs(Rinv(0, 0) - 1.0) < 1e-15,
-                            "POLY3 " << poly3_reading_name(options.reading) << ": Basin's car equations hold for "
-                                     << "Q = 0 and R = 1 only");
-      for (long k = 0; k <= steps; ++k)
-        KUSHNER_INPUT_REQUIRE(std::fabs(B[k](0, 0)) == 0.0 && B[k](n - 1, 0) == 1.0,
-                              "POLY3 " << poly3_reading_name(options.reading) << ": needs B = (0, 1)^T");
+      // Decided at compile time: for other sizes the checks below would be unreachable (nvcc warned, #128-D).
+      if constexpr (n != 2 || m != 1) {
+        KUSHNER_INPUT_REQUIRE(false, "POLY3 " << poly3_reading_name(options.reading)
+                                              << ": Basin's car equations need 2 states and 1 control");
+      } else {
+        KUSHNER_INPUT_REQUIRE(Qc.cwiseAbs().maxCoeff() == 0.0 && std::fabs(Rinv(0, 0) - 1.0) < 1e-15,
+                              "POLY3 " << poly3_reading_name(options.reading) << ": Basin's car equations hold for "
+                                       << "Q = 0 and R = 1 only");
+        for (long k = 0; k <= steps; ++k)
+          KUSHNER_INPUT_REQUIRE(std::fabs(B[k](0, 0)) == 0.0 && B[k](n - 1, 0) == 1.0,
+                                "POLY3 " << poly3_reading_name(options.reading) << ": needs B = (0, 1)^T");
+      }
     }
   }
 
