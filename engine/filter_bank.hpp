@@ -197,7 +197,7 @@ class FilterBank {
   template <class F>
   void with_slot(const std::string& name, F&& f) const {
     bool found = false;
-    for_each_slot([&](const auto& slot) {
+    for_each_filter_slot(slots_, [&](const auto& slot) {
       if (slot.enabled && name == decltype(slot.filter)::name) {
         found = true;
         f(slot);
@@ -214,7 +214,7 @@ class FilterBank {
   /// The selected filters of the bank (not the outside estimators), in slot order.
   std::vector<std::string> filter_names() const {
     std::vector<std::string> names;
-    for_each_slot([&](const auto& slot) {
+    for_each_filter_slot(slots_, [&](const auto& slot) {
       if (slot.enabled) names.push_back(decltype(slot.filter)::name);
     });
     return names;
@@ -229,7 +229,7 @@ class FilterBank {
   /// What filter `name` (a selected one) adds to its summary (kernels/filters/filter_protocol.hpp).
   Fields summary_fields(const std::string& name) const {
     Fields fields;
-    for_each_slot([&](const auto& slot) {
+    for_each_filter_slot(slots_, [&](const auto& slot) {
       if (slot.enabled && name == decltype(slot.filter)::name) fields = filter_summary_fields(slot.filter);
     });
     return fields;
@@ -258,15 +258,6 @@ class FilterBank {
   long truths_escaped() const;
 
  private:
-  template <class F>
-  void for_each_slot(F&& f) {
-    for_each_filter_slot(slots_, f);
-  }
-  template <class F>
-  void for_each_slot(F&& f) const {
-    for_each_filter_slot(slots_, f);
-  }
-
   struct Estimator {
     ReferenceEstimator<MemSpace>* estimator = nullptr;
     std::string name;
@@ -545,7 +536,7 @@ void FilterBank<ExecSpace, Model, TruthModel>::visit_state(StateArchive& archive
   archive.view("x", truths_.state());
   archive.view("observations", truths_.observations());
   archive.view("status", truth_status_);
-  for_each_slot([&](auto& slot) {
+  for_each_filter_slot(slots_, [&](auto& slot) {
     using Filter = decltype(slot.filter);
     if (!slot.enabled) return;
     archive.scope = std::string(Filter::name) + ".";

@@ -86,8 +86,9 @@ class ParticleFilterBank {
       : ParticleFilterBank(space, model, num_members, num_particles, seed,
                            ParticleFilterOptions{scheme, ess_threshold}) {}
 
-  /// Samples the initial particles and computes the time-0 posterior. Requires sizes >= 1 and a threshold in
-  /// [0, 1] (std::logic_error otherwise: user input is checked where it is read, drivers/filter_options.cpp).
+  /// Samples the initial particles and computes the time-0 posterior. Requires members >= 0 (an MPI rank may hold
+  /// none: engine/member_share.hpp), particles >= 1 and a threshold in [0, 1] (std::logic_error otherwise: user
+  /// input is checked where it is read, drivers/filter_options.cpp).
   ParticleFilterBank(const ExecSpace& space, const Model& model, int num_members, int num_particles, Seed seed,
                      const ParticleFilterOptions& options);
 
@@ -396,7 +397,7 @@ ParticleFilterBank<ExecSpace, Model>::ParticleFilterBank(const ExecSpace& space,
       seed_(seed),
       num_members_(num_members),
       num_particles_(num_particles) {
-  KUSHNER_REQUIRE(num_members >= 1, "members: " << num_members);
+  KUSHNER_REQUIRE(num_members >= 0, "members: " << num_members);
   KUSHNER_REQUIRE(num_particles >= 1, "particles: " << num_particles);
   KUSHNER_REQUIRE(options.ess_threshold >= 0.0 && options.ess_threshold <= 1.0,
                   "ess_threshold: " << options.ess_threshold);

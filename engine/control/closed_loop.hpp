@@ -77,7 +77,7 @@ class ControlLoop {
   BankVector<MemSpace> estimate() const {
     if (pf_) return pf_->posterior_mean();
     BankVector<MemSpace> out = truths_.state();
-    for_each_slot([&](const auto& slot) {
+    for_each_filter_slot(slots_, [&](const auto& slot) {
       if (slot.enabled) out = slot.m;
     });
     return out;
@@ -93,7 +93,7 @@ class ControlLoop {
   /// What the estimator adds to the summary (a bank filter's summary fields; the particle filter's settings).
   Fields estimator_fields() const {
     Fields fields;
-    for_each_slot([&](const auto& slot) {
+    for_each_filter_slot(slots_, [&](const auto& slot) {
       if (slot.enabled) fields = filter_summary_fields(slot.filter);
     });
     if (pf_)
@@ -109,19 +109,17 @@ class ControlLoop {
   const std::string& estimator() const { return estimator_; }
 
  private:
-  template <class F>
-  void for_each_slot(F&& f) {
-    for_each_filter_slot(slots_, f);
+  /// Whether the estimator keeps a status per member (a filter, the particle filter; not the true state). Decided
+  /// by the estimator, not by the status view's size: a rank may hold no members, and the counts are collective.
+  bool estimator_has_status() const {
+    bool has = static_cast<bool>(pf_);
+    for_each_filter_slot(slots_, [&](const auto& slot) { has = has || slot.enabled; });
+    return has;
   }
-  template <class F>
-  void for_each_slot(F&& f) const {
-    for_each_filter_slot(slots_, f);
-  }
-
   BankScalar<Status, MemSpace> estimator_status() const {
     if (pf_) return pf_->status();
     BankScalar<Status, MemSpace> status;
-    for_each_slot([&](const auto& slot) {
+    for_each_filter_slot(slots_, [&](const auto& slot) {
       if (slot.enabled) status = slot.status;
     });
     return status;
@@ -215,16 +213,17 @@ std::vector<char> ControlLoop<ExecSpace, Model>::members_ok() const {
   std::vector<char> ok(members_, 0);
   space_.fence();
   const auto truth = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), truth_status_);
+  const bool has_status = estimator_has_status();
   const auto status = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), estimator_status());
   for (long member = 0; member < members_; ++member)
-    ok[member] = truth(member) == Status::ok && (status.extent(0) == 0 || status(member) == Status::ok);
+    ok[member] = truth(member) == Status::ok && (!has_status || status(member) == Status::ok);
   return ok;
 }
 
 template <class ExecSpace, class Model>
 long ControlLoop<ExecSpace, Model>::estimator_diverged() const {
+  if (!estimator_has_status()) return 0;
   const BankScalar<Status, MemSpace> status = estimator_status();
-  if (status.extent(0) == 0) return 0;
   return count_status(space_, status, Status::not_positive_definite, truth_status_) +
          count_status(space_, status, Status::non_finite, truth_status_);
 }
