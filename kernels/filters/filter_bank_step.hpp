@@ -27,6 +27,9 @@ struct FilterBankStep {
   BankScalar<Status, MemSpace> truth_status;  // non_finite once a truth escaped: not filtered, not scored
   FilterSlots<MemSpace, Filters...> slots;
   bool record;  // the step ends at an output time: fill the snapshots
+  // A reference mean scores the filters after the step (FilterBankReferenceScore). Without one no snapshot's
+  // reference column is read, and the host lanes leave it alone (8 B read and written per filter and member).
+  bool has_reference;
 
   KOKKOS_INLINE_FUNCTION void operator()(const int member) const {
     constexpr int n = Model::state_dim, p = Model::obs_dim;
@@ -144,11 +147,16 @@ struct FilterBankStep {
       const double nan = math::quiet_nan();
       KUSHNER_SIMD
       for (int member = begin; member < end; ++member) {
-        const double e = error[member - begin];
-        double& reference = snapshot[member + snapshot_reference_squared_error * snapshot_stride];
-        snapshot[member + snapshot_squared_error * snapshot_stride] = e;
+        snapshot[member + snapshot_squared_error * snapshot_stride] = error[member - begin];
         snapshot[member + snapshot_nees * snapshot_stride] = nees[member - begin];
-        reference = e == e ? reference : nan;  // NaN error: not scored, as mark_unscored
+      }
+      if (has_reference) {
+        KUSHNER_SIMD
+        for (int member = begin; member < end; ++member) {
+          const double e = error[member - begin];
+          double& reference = snapshot[member + snapshot_reference_squared_error * snapshot_stride];
+          reference = e == e ? reference : nan;  // NaN error: not scored, as mark_unscored
+        }
       }
     }
   }
