@@ -25,8 +25,8 @@ void add_run_options(CLI::App& app, RunOptions& o) {
   app.add_option("--seed", o.seed, "random seed, 0 .. 4294967295")->capture_default_str();
   app.add_option("--out", o.out, "output directory (created if missing)")->capture_default_str();
   app.add_option("--output-points", o.output_points,
-                 "time points of timeseries.csv: 0, every (T/dt / N)-th step (rounded down) and T, so N + 1 "
-                 "where N divides T/dt (at most T/dt + 1; the default is capped there)")
+                 "N, for the time points of timeseries.csv: 0, every (T/dt / N)-th step (rounded down) and T, "
+                 "so N + 1 where N divides T/dt (at most T/dt + 1; the default is capped there)")
       ->capture_default_str()
       ->each([&o](const std::string&) { o.output_points_given = true; });
   app.add_flag("--quiet", o.quiet, "no progress bar");
