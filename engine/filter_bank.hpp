@@ -326,11 +326,7 @@ class FilterBank {
     const auto step = static_cast<std::uint32_t>(k);
     typename K::Step kernel{
         TruthStep<TruthModel, MemSpace>{truth_model_, truths_.state(), truths_.observations(), k * dt, dt, seed_, step},
-        filter_model_,
-        truth_status_,
-        slots_,
-        record,
-        reference_ != nullptr};
+        filter_model_, truth_status_, slots_, record};
     parallel_for_members("kushner::filter_bank_step", space_, members_, kernel);
   }
 

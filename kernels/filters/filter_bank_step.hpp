@@ -27,9 +27,6 @@ struct FilterBankStep {
   BankScalar<Status, MemSpace> truth_status;  // non_finite once a truth escaped: not filtered, not scored
   FilterSlots<MemSpace, Filters...> slots;
   bool record;  // the step ends at an output time: fill the snapshots
-  // A reference mean scores the filters after the step (FilterBankReferenceScore). Without one no snapshot's
-  // reference column is read, and the host lanes leave it alone (8 B read and written per filter and member).
-  bool has_reference;
 
   KOKKOS_INLINE_FUNCTION void operator()(const int member) const {
     constexpr int n = Model::state_dim, p = Model::obs_dim;
@@ -142,21 +139,14 @@ struct FilterBankStep {
                        lane_V, xs, x_stride, dys, dy_stride);
     for (int member = begin; member < end; ++member) slot.status(member) = static_cast<Status>(status[member - begin]);
     if constexpr (Record) {
+      // The reference column is not touched: with a reference, its score (FilterBankReferenceScore, after the step
+      // at every output time) writes it for every member; without one nothing reads it.
       double* const snapshot = slot.snapshot.data();
       const std::size_t snapshot_stride = slot.snapshot.stride(1);
-      const double nan = math::quiet_nan();
       KUSHNER_SIMD
       for (int member = begin; member < end; ++member) {
         snapshot[member + snapshot_squared_error * snapshot_stride] = error[member - begin];
         snapshot[member + snapshot_nees * snapshot_stride] = nees[member - begin];
-      }
-      if (has_reference) {
-        KUSHNER_SIMD
-        for (int member = begin; member < end; ++member) {
-          const double e = error[member - begin];
-          double& reference = snapshot[member + snapshot_reference_squared_error * snapshot_stride];
-          reference = e == e ? reference : nan;  // NaN error: not scored, as mark_unscored
-        }
       }
     }
   }
