@@ -242,9 +242,17 @@ class FilterBank {
   FilterSnapshot snapshot(const std::string& name) const { return snapshots({name}).front(); }
 
   /// snapshot() of every filter of `names`: the moments of all their snapshot columns in one pass (ColumnMoments)
-  /// and their divergence counts in another (DivergedCounts), whatever the number of filters: on a GPU each pass
-  /// waits for the device once.
-  std::vector<FilterSnapshot> snapshots(const std::vector<std::string>& names) const;
+  /// and their divergence counts in another (DivergedCounts), whatever the number of filters.
+  std::vector<FilterSnapshot> snapshots(const std::vector<std::string>& names) const {
+    start_snapshots(names);
+    return finish_snapshots();
+  }
+
+  /// snapshots() in two halves: start_snapshots queues the reductions of the bank's present time and their copies
+  /// to the host; finish_snapshots waits for them (not for work queued since) and gives the snapshots. Between the
+  /// two the bank may take its next step: on a GPU the host's merge then runs beside it (engine/filter_run.hpp).
+  void start_snapshots(const std::vector<std::string>& names) const;
+  std::vector<FilterSnapshot> finish_snapshots() const;
 
   /// Metrics of filter `name` over the run so far: `points` time points have been scored (steps + 1).
   FilterScores scores(const std::string& name, long points) const;
@@ -391,6 +399,12 @@ class FilterBank {
   KeptStep kept_;
   mutable ColumnMoments<ExecSpace> snapshot_moments_;  // buffers kept from one output step to the next
   mutable DivergedCounts<ExecSpace> diverged_counts_;
+  struct PendingSnapshots {
+    bool started = false;
+    std::vector<std::string> names;
+    std::vector<int> first;  // names[i]'s first column in snapshot_moments_
+  };
+  mutable PendingSnapshots pending_;
 };
 
 template <class ExecSpace, class Model, class TruthModel>
@@ -476,22 +490,34 @@ std::vector<char> FilterBank<ExecSpace, Model, TruthModel>::members_ok(const std
 }
 
 template <class ExecSpace, class Model, class TruthModel>
-std::vector<FilterSnapshot> FilterBank<ExecSpace, Model, TruthModel>::snapshots(
-    const std::vector<std::string>& names) const {
+void FilterBank<ExecSpace, Model, TruthModel>::start_snapshots(const std::vector<std::string>& names) const {
+  KUSHNER_REQUIRE(!pending_.started, "start_snapshots: the previous snapshots were not finished");
   std::vector<typename ColumnMoments<ExecSpace>::Column> columns;
   std::vector<BankScalar<Status, MemSpace>> statuses;
-  std::vector<int> first;  // names[i]'s columns start at first[i]: squared error, NEES[, reference]
+  pending_.first.clear();
   for (const auto& name : names)
     with_slot(name, [&](const auto& slot) {
-      first.push_back(static_cast<int>(columns.size()));
+      pending_.first.push_back(static_cast<int>(columns.size()));
       columns.push_back(Kokkos::subview(slot.snapshot, Kokkos::ALL, int(snapshot_squared_error)));
       columns.push_back(Kokkos::subview(slot.snapshot, Kokkos::ALL, int(snapshot_nees)));
       if (scored_against_reference(name))
         columns.push_back(Kokkos::subview(slot.snapshot, Kokkos::ALL, int(snapshot_reference_squared_error)));
       statuses.push_back(slot.status);
     });
-  const std::vector<EnsembleMoments> moments = snapshot_moments_(space_, columns);
-  const std::vector<long> diverged = diverged_counts_(space_, statuses, truth_status_);
+  snapshot_moments_.start(space_, columns);
+  diverged_counts_.start(space_, statuses, truth_status_);
+  pending_.names = names;
+  pending_.started = true;
+}
+
+template <class ExecSpace, class Model, class TruthModel>
+std::vector<FilterSnapshot> FilterBank<ExecSpace, Model, TruthModel>::finish_snapshots() const {
+  KUSHNER_REQUIRE(pending_.started, "finish_snapshots: no snapshots started");
+  pending_.started = false;
+  const std::vector<EnsembleMoments> moments = snapshot_moments_.finish();
+  const std::vector<long> diverged = diverged_counts_.finish();
+  const std::vector<std::string>& names = pending_.names;
+  const std::vector<int>& first = pending_.first;  // names[i]'s columns start at first[i]: squared error, NEES[, ref]
   std::vector<FilterSnapshot> result;
   for (std::size_t i = 0; i < names.size(); ++i) {
     FilterSnapshot s;

@@ -170,10 +170,18 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
     bank.add_estimator(e.get());
     outside_view.push_back(e.get());
   }
-  auto record = [&](double t) {
+  // An output time's metrics are queued when the bank reaches it and collected once the next step is queued (or
+  // before a checkpoint, or at the end): on a GPU the host merges them while the device takes that step.
+  bool collecting = false;
+  const auto record = [&](double t) {
     report.times.push_back(t);
-    report.series.push_back(bank.snapshots(report.filters));
+    bank.start_snapshots(report.filters);
+    collecting = true;
     if (observer) observer(t, bank, outside_view);
+  };
+  const auto collect = [&] {
+    if (collecting) report.series.push_back(bank.finish_snapshots());
+    collecting = false;
   };
   // Everything that carries from one step to the next, in a fixed order; `step`: the steps taken.
   const auto visit_run_state = [&](StateArchive& archive, long& step) {
@@ -209,6 +217,7 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
   }
   CheckpointClock clock(checkpointing.every_seconds);
   const auto save = [&](long step) {
+    collect();
     StateArchive archive;
     visit_run_state(archive, step);
     checkpointing.write(archive.bytes(), step, grid.steps);
@@ -231,6 +240,7 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
       bank.step_pair(k, grid.dt, output);
     else
       bank.step(k, grid.dt, output);
+    collect();
     k = done;
     if (output) {
       record(k * grid.dt);
@@ -245,6 +255,7 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
                                std::to_string(grid.steps) + "; checkpoint written" + checkpointing.resume_hint,
                            signal);
   }
+  collect();
   space.fence();
   report.step_loop_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - loop_start).count();
   report.steps_run = grid.steps - first_step;

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The filter bank's GPU figures in two device calls (phases: build, run; issue 16 part 4):
-#   build  build-cuda-bank/: CUDA + Serial, kushner and test_ensemble_moments (16 command units: one 10-minute call)
-#   run    test_ensemble_moments on the GPU (the output step's moments and counts against the host's); then
-#          perf/compare_bank_gpu.sh (kushner CLI vs JAX vs the copy floor, M = 1e6); the same CLI runs with 2 output
+#   build  build-cuda-bank/: CUDA + Serial, kushner and test_ensemble_moments (16 command units; one 10-minute call
+#          on 16 cores, about 6 minutes on 32)
+#   run    test_ensemble_moments on the GPU (the output step's moments and counts against the host's) and
+#          tests/cli/test_filter_determinism.sh (Serial against CUDA); then perf/compare_bank_gpu.sh (kushner CLI vs JAX vs the copy floor, M = 1e6); the same CLI runs with 2 output
 #          points instead of 200 (what an output step costs); Nsight Systems' kernel and API summaries of one run
 #          where nsys is installed
 #   profile time per kernel and copy of one run (T = 0.05, 1e6 members), with perf/kokkos_kernel_timer.cpp and
@@ -25,7 +26,7 @@ if want build; then
   cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON -DKUSHNER_ENABLE_OPENMP=OFF \
     -DKUSHNER_ENABLE_SERIAL=ON -DKUSHNER_ENABLE_MPI=OFF -DKUSHNER_COMMAND_UNITS=16 > "$out/configure.log" 2>&1 ||
     { tail -20 "$out/configure.log"; exit 1; }
-  cmake --build "$build" -j16 --target kushner test_ensemble_moments > "$out/build.log" 2>&1 || status=1
+  cmake --build "$build" -j"$(nproc)" --target kushner test_ensemble_moments > "$out/build.log" 2>&1 || status=1
   grep -h -B2 -A10 -m3 " error" "$out/build.log" | head -40
   log "built (status $status)"
 fi
@@ -34,6 +35,10 @@ if want run; then
   log "test_ensemble_moments (CUDA, Serial)"
   "$build/tests/test_ensemble_moments" > "$out/test_ensemble_moments.log" 2>&1 || status=1
   grep -E "^\[  (PASSED|FAILED)|FAILED \]" "$out/test_ensemble_moments.log" | tee -a "$out/steps.log"
+  log "tests/cli/test_filter_determinism.sh (Serial vs CUDA)"
+  bash "$here/tests/cli/test_filter_determinism.sh" "$build/kushner" > "$out/test_filter_determinism.log" 2>&1 ||
+    status=1
+  tail -3 "$out/test_filter_determinism.log" | tee -a "$out/steps.log"
   log "compare_bank_gpu.sh"
   KUSHNER_REPETITIONS=${KUSHNER_REPETITIONS:-3} bash "$here/perf/compare_bank_gpu.sh" "$build" 2>&1 |
     tee "$out/compare_bank_gpu.log" || status=1

@@ -66,51 +66,53 @@ TYPED_TEST(EnsembleMomentsTest, EqualToTheSerialResult) {
 
 /// ColumnMoments (the bank's output steps) gives, column by column, ensemble_moments of that column alone, bit for
 /// bit on the host (and to 1e-13 on a GPU), with a member left out of a column only where that column is not
-/// finite; also with blocks shorter than the eight partial sums (1003 and 5 members) and when the same object is
-/// called again with the same columns (its kept buffers) or with other ones.
+/// finite; also with blocks shorter than the eight partial sums (1003 and 5 members), when the same object is
+/// called again with the same columns (its kept buffers) or with other ones, and in both forms of its kernel (one
+/// thread per block and column, or a team: a GPU's default).
 TYPED_TEST(EnsembleMomentsTest, ColumnMomentsEqualEachColumnsEnsembleMoments) {
   using MemSpace = typename TypeParam::memory_space;
   const bool host_space = Kokkos::SpaceAccessibility<Kokkos::HostSpace, MemSpace>::accessible;
-  for (const int members : {1003, 5}) {
-    Kokkos::View<double**, Kokkos::LayoutLeft, Kokkos::HostSpace> host("x", members, 3);
-    for (int m = 0; m < members; ++m) {
-      host(m, 0) = std::sin(0.37 * m) + 3.0;
-      host(m, 1) = 1e3 + std::cos(1.3 * m);
-      host(m, 2) = 1e-3 * m * m;
-    }
-    host(members - 1, 1) = std::numeric_limits<double>::quiet_NaN();
-    host(members / 2, 2) = -std::numeric_limits<double>::infinity();
-    auto x = Kokkos::create_mirror_view_and_copy(MemSpace(), host);
-    ColumnMoments<TypeParam> moments;
-    for (const std::vector<int>& order :
-         {std::vector<int>{0, 1, 2}, std::vector<int>{0, 1, 2}, std::vector<int>{2, 0}}) {
-      std::vector<typename ColumnMoments<TypeParam>::Column> columns;
-      for (const int c : order) columns.push_back(Kokkos::subview(x, Kokkos::ALL, c));
-      const auto result = moments(TypeParam(), columns);
-      ASSERT_EQ(result.size(), order.size());
-      for (std::size_t i = 0; i < order.size(); ++i) {
-        const int c = order[i];
-        const auto alone =
-            ensemble_moments(Kokkos::Serial(), Kokkos::subview(host, Kokkos::ALL, std::make_pair(c, c + 1)));
-        EXPECT_EQ(result[i].non_finite, (c == 0 ? 0 : 1)) << members << " members, column " << c;
-        EXPECT_EQ(result[i].members, members);
-        double sum = 0.0, n = 0.0, ss = 0.0;  // directly, over the column's finite values
-        for (int m = 0; m < members; ++m)
-          if (std::isfinite(host(m, c))) sum += host(m, c), n += 1.0;
-        for (int m = 0; m < members; ++m)
-          if (std::isfinite(host(m, c))) ss += (host(m, c) - sum / n) * (host(m, c) - sum / n);
-        EXPECT_NEAR(result[i].mean[0], sum / n, 1e-13 * std::abs(sum / n)) << members << " members, column " << c;
-        EXPECT_NEAR(result[i].variance[0], ss / (n - 1), 1e-12 * ss / (n - 1)) << members << " members, column " << c;
-        if (host_space) {
-          EXPECT_EQ(result[i].mean[0], alone.mean[0]) << members << " members, column " << c;
-          EXPECT_EQ(result[i].variance[0], alone.variance[0]) << members << " members, column " << c;
-        } else {
-          EXPECT_NEAR(result[i].mean[0], alone.mean[0], 1e-13 * std::abs(alone.mean[0]));
-          EXPECT_NEAR(result[i].variance[0], alone.variance[0], 1e-13 * alone.variance[0]);
+  for (const bool teams : {false, true})
+    for (const int members : {1003, 5}) {
+      Kokkos::View<double**, Kokkos::LayoutLeft, Kokkos::HostSpace> host("x", members, 3);
+      for (int m = 0; m < members; ++m) {
+        host(m, 0) = std::sin(0.37 * m) + 3.0;
+        host(m, 1) = 1e3 + std::cos(1.3 * m);
+        host(m, 2) = 1e-3 * m * m;
+      }
+      host(members - 1, 1) = std::numeric_limits<double>::quiet_NaN();
+      host(members / 2, 2) = -std::numeric_limits<double>::infinity();
+      auto x = Kokkos::create_mirror_view_and_copy(MemSpace(), host);
+      ColumnMoments<TypeParam> moments(teams);
+      for (const std::vector<int>& order :
+           {std::vector<int>{0, 1, 2}, std::vector<int>{0, 1, 2}, std::vector<int>{2, 0}}) {
+        std::vector<typename ColumnMoments<TypeParam>::Column> columns;
+        for (const int c : order) columns.push_back(Kokkos::subview(x, Kokkos::ALL, c));
+        const auto result = moments(TypeParam(), columns);
+        ASSERT_EQ(result.size(), order.size());
+        for (std::size_t i = 0; i < order.size(); ++i) {
+          const int c = order[i];
+          const auto alone =
+              ensemble_moments(Kokkos::Serial(), Kokkos::subview(host, Kokkos::ALL, std::make_pair(c, c + 1)));
+          EXPECT_EQ(result[i].non_finite, (c == 0 ? 0 : 1)) << members << " members, column " << c;
+          EXPECT_EQ(result[i].members, members);
+          double sum = 0.0, n = 0.0, ss = 0.0;  // directly, over the column's finite values
+          for (int m = 0; m < members; ++m)
+            if (std::isfinite(host(m, c))) sum += host(m, c), n += 1.0;
+          for (int m = 0; m < members; ++m)
+            if (std::isfinite(host(m, c))) ss += (host(m, c) - sum / n) * (host(m, c) - sum / n);
+          EXPECT_NEAR(result[i].mean[0], sum / n, 1e-13 * std::abs(sum / n)) << members << " members, column " << c;
+          EXPECT_NEAR(result[i].variance[0], ss / (n - 1), 1e-12 * ss / (n - 1)) << members << " members, column " << c;
+          if (host_space) {
+            EXPECT_EQ(result[i].mean[0], alone.mean[0]) << members << " members, column " << c;
+            EXPECT_EQ(result[i].variance[0], alone.variance[0]) << members << " members, column " << c;
+          } else {
+            EXPECT_NEAR(result[i].mean[0], alone.mean[0], 1e-13 * std::abs(alone.mean[0]));
+            EXPECT_NEAR(result[i].variance[0], alone.variance[0], 1e-13 * alone.variance[0]);
+          }
         }
       }
     }
-  }
 }
 
 /// DivergedCounts: for each status column, count_status of not_positive_definite plus that of non_finite among the

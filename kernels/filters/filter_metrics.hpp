@@ -11,6 +11,7 @@
 #include "kernels/ensemble_moments.hpp"
 #include "kernels/filters/filter_slot.hpp"
 #include "kernels/host_copy.hpp"
+#include "kernels/queue_mark.hpp"
 
 #include <Kokkos_Core.hpp>
 
@@ -70,23 +71,20 @@ long count_status(const ExecSpace& space, const BankScalar<Status, MemSpace>& st
   return collective::sum(count);  // over every rank's members
 }
 
-/// counts(b, s) = members of block b (moment_block_size members) whose truth is ok and whose status in column s is
-/// not: one (block, column) pair per index i = s * blocks + b, like the moments' blocks. (For 1e6 members and 4
-/// filters on an H100, a Kokkos array reduction over members took 197 us per call; this takes 64 us.)
+/// counts(s) = members whose truth is ok and whose status in column s is not: one thread per member, an atomic add
+/// where a member counts (a diverged filter: rare). Integer adds, so any order gives the same count. (For 1e6
+/// members and 4 filters on an H100: a Kokkos array reduction over members took 197 us per call, a thread per
+/// 256-member block and column 64 us, a team per block and column 46 us on an H200.)
 template <class MemSpace>
-struct BlockNotOkCounts {
+struct NotOkCounts {
   Kokkos::View<const std::uintptr_t*, MemSpace> statuses;  // column s at (const Status*) statuses(s)
   BankScalar<Status, MemSpace> truth_status;
-  Kokkos::View<int**, Kokkos::LayoutRight, MemSpace> counts;
+  Kokkos::View<int*, MemSpace> counts;
 
-  KOKKOS_INLINE_FUNCTION void operator()(const int i) const {
-    const int num_blocks = static_cast<int>(counts.extent(0)), b = i % num_blocks, s = i / num_blocks;
-    const Status* status = reinterpret_cast<const Status*>(statuses(s));
-    const int end = block_end(b, static_cast<int>(truth_status.extent(0)));
-    int count = 0;
-    for (int m = b * moment_block_size; m < end; ++m)
-      count += truth_status(m) == Status::ok && status[m] != Status::ok ? 1 : 0;
-    counts(b, s) = count;
+  KOKKOS_INLINE_FUNCTION void operator()(const int m) const {
+    if (truth_status(m) != Status::ok) return;
+    for (int s = 0; s < static_cast<int>(counts.extent(0)); ++s)
+      if (reinterpret_cast<const Status*>(statuses(s))[m] != Status::ok) Kokkos::atomic_increment(&counts(s));
   }
 };
 
@@ -100,37 +98,50 @@ class DivergedCounts {
 
   std::vector<long> operator()(const ExecSpace& space, const std::vector<BankScalar<Status, MemSpace>>& statuses,
                                const BankScalar<Status, MemSpace>& truth_status) {
-    std::vector<long> totals(statuses.size(), 0);
-    if (statuses.empty()) return totals;
+    start(space, statuses, truth_status);
+    return finish();
+  }
+
+  /// Queues the counts on `space` (kernel and copy to the host), like ColumnMoments::start; finish() waits and sums.
+  void start(const ExecSpace& space, const std::vector<BankScalar<Status, MemSpace>>& statuses,
+             const BankScalar<Status, MemSpace>& truth_status) {
+    columns_count_ = static_cast<int>(statuses.size());
+    if (columns_count_ == 0) return;
     std::vector<std::uintptr_t> addresses;
     for (const auto& s : statuses) {
       KUSHNER_REQUIRE(s.extent(0) == truth_status.extent(0), "DivergedCounts: a status column of another bank");
       addresses.push_back(reinterpret_cast<std::uintptr_t>(s.data()));
     }
-    const int members = static_cast<int>(truth_status.extent(0));
-    const int num_blocks = static_cast<int>(moment_blocks(members));
-    const int columns = static_cast<int>(statuses.size());
-    if (counts_.extent(0) != static_cast<std::size_t>(num_blocks) || counts_.extent(1) != statuses.size()) {
-      counts_ = decltype(counts_)(Kokkos::view_alloc(space, Kokkos::WithoutInitializing, "kushner::diverged_counts"),
-                                  num_blocks, columns);
+    if (counts_.extent(0) != statuses.size()) {
+      counts_ = Kokkos::View<int*, MemSpace>(Kokkos::view_alloc(space, "kushner::diverged_counts"), columns_count_);
       // The counts themselves in host memory; a page-locked copy of them on a GPU.
       host_ = Kokkos::create_mirror_view(typename HostStaging<MemSpace>::space(), counts_);
     }
-    Kokkos::parallel_for("kushner::diverged_counts", Kokkos::RangePolicy<ExecSpace>(space, 0, num_blocks * columns),
-                         BlockNotOkCounts<MemSpace>{columns_.update(space, addresses), truth_status, counts_});
-    space.fence();
-    if (host_.data() != counts_.data()) Kokkos::deep_copy(host_, counts_);
-    for (int b = 0; b < num_blocks; ++b)
-      for (int s = 0; s < columns; ++s) totals[s] += host_(b, s);
-    for (auto& t : totals) t = collective::sum(t);  // every rank, the same calls in the same order
+    Kokkos::deep_copy(space, counts_, 0);
+    Kokkos::parallel_for("kushner::diverged_counts",
+                         Kokkos::RangePolicy<ExecSpace>(space, 0, static_cast<long>(truth_status.extent(0))),
+                         NotOkCounts<MemSpace>{columns_.update(space, addresses), truth_status, counts_});
+    if (host_.data() != counts_.data()) Kokkos::deep_copy(space, host_, counts_);
+    done_.record(space);
+  }
+
+  /// The counts start() queued, per status column, over every rank (a collective call); like
+  /// ColumnMoments::finish, waits for start()'s work only.
+  std::vector<long> finish() {
+    std::vector<long> totals(columns_count_, 0);
+    if (columns_count_ == 0) return totals;
+    done_.wait();
+    for (int s = 0; s < columns_count_; ++s) totals[s] = collective::sum(static_cast<long>(host_(s)));
     return totals;
   }
 
  private:
-  using HostCounts = Kokkos::View<int**, Kokkos::LayoutRight, typename HostStaging<MemSpace>::space>;
+  using HostCounts = Kokkos::View<int*, typename HostStaging<MemSpace>::space>;
   DeviceAddresses<MemSpace> columns_;
-  Kokkos::View<int**, Kokkos::LayoutRight, MemSpace> counts_;
+  Kokkos::View<int*, MemSpace> counts_;
   HostCounts host_;
+  int columns_count_ = 0;  // of the last start()
+  QueueMark<ExecSpace> done_;
 };
 
 }  // namespace kushner
