@@ -66,7 +66,7 @@ PY
   fi
 fi
 if want profile; then
-  log "kernel timer (CUDA_LAUNCH_BLOCKING=1, T = 0.05: 50 steps, 40 output steps)"
+  log "kernel timer (CUDA_LAUNCH_BLOCKING=1, T = 0.05: 50 steps, every one an output step)"
   g++ -O2 -shared -fPIC "$here/perf/kokkos_kernel_timer.cpp" -o "$build/kernel_timer.so" || status=1
   CUDA_LAUNCH_BLOCKING=1 KOKKOS_PROFILE_LIBRARY="$build/kernel_timer.so" KUSHNER_BACKEND=cuda "$build/kushner" filter \
     --model sine --filters EKF,SOF,QLF,KBL --members 1000000 --T 0.05 --out "$out/profile-run" --quiet \
