@@ -66,7 +66,7 @@ TYPED_TEST(EnsembleMomentsTest, EqualToTheSerialResult) {
 
 /// ColumnMoments (the bank's output steps) gives, column by column, ensemble_moments of that column alone, bit for
 /// bit on the host (and to 1e-13 on a GPU), with a member left out of a column only where that column is not
-/// finite; also with blocks shorter than the eight partial sums (1003 and 5 members), when the same object is
+/// finite; also with blocks shorter than a block or its 32 lanes (1003 and 5 members), when the same object is
 /// called again with the same columns (its kept buffers) or with other ones, and in both forms of its kernel (one
 /// thread per block and column, or a team: a GPU's default).
 TYPED_TEST(EnsembleMomentsTest, ColumnMomentsEqualEachColumnsEnsembleMoments) {
