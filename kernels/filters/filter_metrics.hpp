@@ -89,8 +89,8 @@ struct NotOkCounts {
 };
 
 /// For each of `statuses` (filters of one bank): count_status of not_positive_definite plus that of non_finite
-/// among the members whose truth is ok, over every rank; one kernel and one copy for all of them. Keeps its device
-/// list of the columns and its buffers from call to call, like ColumnMoments.
+/// among the members whose truth is ok, over every rank; one kernel (after zeroing the counters) and one copy for all
+/// of them. Keeps its device list of the columns and its buffers from call to call, like ColumnMoments.
 template <class ExecSpace>
 class DivergedCounts {
  public:
