@@ -241,8 +241,8 @@ class FilterBank {
   /// Metrics of filter `name` at the latest output time.
   FilterSnapshot snapshot(const std::string& name) const { return snapshots({name}).front(); }
 
-  /// snapshot() of every filter of `names`: the moments of all their snapshot columns in one pass (ColumnMoments)
-  /// and their divergence counts in another (DivergedCounts), whatever the number of filters.
+  /// snapshot() of every filter of `names`: the moments of all their snapshot columns and their divergence counts
+  /// in one launch (ColumnMoments with NotOkMembers), whatever the number of filters.
   std::vector<FilterSnapshot> snapshots(const std::vector<std::string>& names) const {
     start_snapshots(names);
     return finish_snapshots();
@@ -398,7 +398,7 @@ class FilterBank {
   std::vector<Estimator> estimators_;
   KeptStep kept_;
   mutable ColumnMoments<ExecSpace> snapshot_moments_;  // buffers kept from one output step to the next
-  mutable DivergedCounts<ExecSpace> diverged_counts_;
+  mutable DivergedMembers<MemSpace> diverged_members_;
   struct PendingSnapshots {
     bool started = false;
     std::vector<std::string> names;
@@ -504,8 +504,7 @@ void FilterBank<ExecSpace, Model, TruthModel>::start_snapshots(const std::vector
         columns.push_back(Kokkos::subview(slot.snapshot, Kokkos::ALL, int(snapshot_reference_squared_error)));
       statuses.push_back(slot.status);
     });
-  snapshot_moments_.start(space_, columns);
-  diverged_counts_.start(space_, statuses, truth_status_);
+  snapshot_moments_.start(space_, columns, diverged_members_(space_, statuses, truth_status_));
   pending_.names = names;
   pending_.started = true;
 }
@@ -514,8 +513,9 @@ template <class ExecSpace, class Model, class TruthModel>
 std::vector<FilterSnapshot> FilterBank<ExecSpace, Model, TruthModel>::finish_snapshots() const {
   KUSHNER_REQUIRE(pending_.started, "finish_snapshots: no snapshots started");
   pending_.started = false;
-  const std::vector<EnsembleMoments> moments = snapshot_moments_.finish();
-  const std::vector<long> diverged = diverged_counts_.finish();
+  const MergedBlocks merged = snapshot_moments_.finish();
+  const std::vector<EnsembleMoments>& moments = merged.moments;
+  const std::vector<long>& diverged = merged.counts;  // per filter of names
   const std::vector<std::string>& names = pending_.names;
   const std::vector<int>& first = pending_.first;  // names[i]'s columns start at first[i]: squared error, NEES[, ref]
   std::vector<FilterSnapshot> result;

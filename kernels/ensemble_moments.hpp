@@ -9,6 +9,7 @@
 #include "core/collectives.hpp"
 #include "core/errors.hpp"
 #include "core/math.hpp"
+#include "core/portability.hpp"
 #include "kernels/bank.hpp"
 #include "kernels/device_addresses.hpp"
 #include "kernels/host_copy.hpp"
@@ -91,20 +92,94 @@ KOKKOS_INLINE_FUNCTION BlockStatistic block_statistic(const Value& value, const 
   return s;
 }
 
-/// block_statistic by a team, one lane per thread (a GPU's warp: at each member step its 32 threads read 32
-/// consecutive values), the lanes meeting in `lanes` (team scratch of 3 moment_lanes doubles): the same sums in
-/// the same order, so the same bits. Every thread of the team returns the statistic.
+/// Members per lane in a block: a lane's values of a block fit in registers.
+constexpr int moment_lane_members = moment_block_size / moment_lanes;
+static_assert(moment_block_size % moment_lanes == 0, "a block is whole lanes");
+
+#if KUSHNER_CUDA_DEVICE_PASS
+/// pairwise_sum<moment_lanes> over the lanes of a warp (lane j's x is a[j]), on every lane: shuffles down by 1, 2,
+/// 4, 8 and 16 add the same pairs in the same tree (after offset d, lane j, a multiple of 2 d, holds the tree's sum
+/// of a[j .. j + 2 d)).
+__device__ inline double warp_pairwise_sum(double x) {
+  static_assert(moment_lanes == 32, "one lane per thread of a warp");
+  KUSHNER_DEVICE_UNROLL
+  for (int offset = 1; offset < moment_lanes; offset *= 2) x += __shfl_down_sync(0xffffffffu, x, offset);
+  return __shfl_sync(0xffffffffu, x, 0);
+}
+
+/// block_statistic by the 32 lanes of a warp, lane j this thread (each lane adds the values of block_statistic's
+/// lane j): the same sums in the same order, so the same bits up to the multiply-adds nvcc contracts. Each lane
+/// loads its (up to) moment_lane_members values at once and keeps them in registers for the second pass; the lanes
+/// meet by shuffles. A position past the block's end reads the block's last value (so no branch keeps the reads from
+/// going out at once) and counts as NaN, which adds zero to every sum, as block_statistic's shorter loop adds
+/// nothing. (The first team form, which loaded a lane's values one after another, four at a time as nvcc
+/// unrolled the loop, loaded them again for the second pass, and had every thread add the 32 lanes from team
+/// scratch, took 49-67 us for 8 columns of 1e6 members on an H200, 2.8-3.9x a read of them.)
+template <class Value>
+__device__ BlockStatistic warp_block_statistic(const int j, const Value& value, const int begin, const int end) {
+  constexpr int L = moment_lanes, K = moment_lane_members;
+  double v[K], count = 0.0, sum = 0.0;
+  KUSHNER_DEVICE_UNROLL
+  for (int k = 0; k < K; ++k) v[k] = value(begin + j + k * L < end ? begin + j + k * L : end - 1);  // no branch
+  KUSHNER_DEVICE_UNROLL
+  for (int k = 0; k < K; ++k) {
+    if (begin + j + k * L >= end) v[k] = math::quiet_nan();
+    const bool finite = math::is_finite(v[k]);
+    count += finite ? 1.0 : 0.0;
+    sum += finite ? v[k] : 0.0;
+  }
+  BlockStatistic s;
+  s.count = warp_pairwise_sum(count);
+  const double total = warp_pairwise_sum(sum);  // every lane takes part in a shuffle
+  if (s.count == 0.0) return s;
+  s.mean = total / s.count;
+  double ss = 0.0;
+  KUSHNER_DEVICE_UNROLL
+  for (int k = 0; k < K; ++k) {
+    const double d = math::is_finite(v[k]) ? v[k] - s.mean : 0.0;
+    ss += d * d;
+  }
+  s.m2 = warp_pairwise_sum(ss);
+  return s;
+}
+
+/// The members m in [begin, end) with counted(m), by the 32 lanes of a warp (lane j this thread, its members as in
+/// warp_block_statistic). A position past the end asks about the block's last member and is not counted, so every
+/// lane's reads are unconditional and go out at once (nvcc kept a branch before each read of a && chain: one read at
+/// a time). An integer: any order gives the same count.
+template <class Counted>
+__device__ int warp_block_count(const int j, const Counted& counted, const int begin, const int end) {
+  bool in[moment_lane_members], yes[moment_lane_members];
+  KUSHNER_DEVICE_UNROLL
+  for (int k = 0; k < moment_lane_members; ++k) {
+    const int m = begin + j + k * moment_lanes;
+    in[k] = m < end;
+    yes[k] = counted(in[k] ? m : end - 1);
+  }
+  double count = 0.0;  // exact: at most moment_block_size
+  KUSHNER_DEVICE_UNROLL
+  for (int k = 0; k < moment_lane_members; ++k) count += in[k] && yes[k] ? 1.0 : 0.0;
+  return static_cast<int>(warp_pairwise_sum(count));
+}
+#endif
+
+/// warp_block_statistic's lanes for any Kokkos team (the host's, where the tests run it): lane j a TeamThreadRange
+/// index, the values and the lanes' sums in team scratch (`scratch`: block_team_scratch_bytes), the lanes added by
+/// pairwise_sum, the tree of warp_pairwise_sum. Every thread of the team returns the statistic.
 template <class Team, class Value>
 KOKKOS_INLINE_FUNCTION BlockStatistic team_block_statistic(const Team& team, const Value& value, const int begin,
-                                                           const int end, double* lanes) {
-  constexpr int L = moment_lanes;
+                                                           const int end, double* scratch) {
+  constexpr int L = moment_lanes, K = moment_lane_members;
+  double* const lanes = scratch;           // 3 L: counts, sums, squared deviations
+  double* const values = scratch + 3 * L;  // K L: the block's values, member begin + i at i
   Kokkos::parallel_for(Kokkos::TeamThreadRange(team, L), [&](const int j) {
-    double count = 0.0, sum = 0.0;
-    for (int m = begin + j; m < end; m += L) {
-      const double v = value(m);
-      const bool finite = math::is_finite(v);
+    double v[K], count = 0.0, sum = 0.0;
+    for (int k = 0; k < K; ++k) v[k] = begin + j + k * L < end ? value(begin + j + k * L) : math::quiet_nan();
+    for (int k = 0; k < K; ++k) {
+      const bool finite = math::is_finite(v[k]);
       count += finite ? 1.0 : 0.0;
-      sum += finite ? v : 0.0;
+      sum += finite ? v[k] : 0.0;
+      values[k * L + j] = v[k];
     }
     lanes[j] = count;
     lanes[L + j] = sum;
@@ -116,8 +191,8 @@ KOKKOS_INLINE_FUNCTION BlockStatistic team_block_statistic(const Team& team, con
   s.mean = pairwise_sum<L>(lanes + L) / s.count;
   Kokkos::parallel_for(Kokkos::TeamThreadRange(team, L), [&](const int j) {
     double ss = 0.0;
-    for (int m = begin + j; m < end; m += L) {
-      const double v = value(m);
+    for (int k = 0; k < K; ++k) {
+      const double v = values[k * L + j];
       const double d = math::is_finite(v) ? v - s.mean : 0.0;
       ss += d * d;
     }
@@ -128,28 +203,46 @@ KOKKOS_INLINE_FUNCTION BlockStatistic team_block_statistic(const Team& team, con
   return s;
 }
 
+/// The members m in [begin, end) with counted(m), by any Kokkos team (its team reduction). Every thread returns it.
+template <class Team, class Counted>
+KOKKOS_INLINE_FUNCTION int team_block_count(const Team& team, const Counted& counted, const int begin, const int end) {
+  int count = 0;
+  Kokkos::parallel_reduce(
+      Kokkos::TeamThreadRange(team, begin, end), [&](const int m, int& n) { n += counted(m) ? 1 : 0; }, count);
+  return count;
+}
+
 /// The work tag of the block reductions' team forms (block_team_policy).
 struct BlockTeams {};
 
-/// Team scratch of team_block_statistic.
-constexpr std::size_t block_team_scratch_bytes = sizeof(double) * 3 * moment_lanes;
+/// Team scratch of team_block_statistic: its lanes' three sums and the block's values.
+constexpr std::size_t block_team_scratch_bytes = sizeof(double) * (3 * moment_lanes + moment_block_size);
 
-/// The team policy of the block reductions' team forms (their operator() tagged BlockTeams): one team per (block,
-/// column) pair, a lane per thread on a GPU (one warp), one thread on the host.
-template <class ExecSpace>
-Kokkos::TeamPolicy<ExecSpace, BlockTeams> block_team_policy(const ExecSpace& space, int pairs) {
-  using MemSpace = typename ExecSpace::memory_space;
-  const int team_size = Kokkos::SpaceAccessibility<Kokkos::HostSpace, MemSpace>::accessible ? 1 : moment_lanes;
-  return Kokkos::TeamPolicy<ExecSpace, BlockTeams>(space, pairs, team_size)
-      .set_scratch_size(0, Kokkos::PerTeam(block_team_scratch_bytes));
-}
+/// Warps per team of the block reductions on a GPU, one (block, column) pair each: teams of one warp, 32 threads
+/// per CUDA block, let an SM hold at most 32 warps (half of an H200's 64) of these short, latency-bound warps.
+constexpr int block_team_warps = 8;
 
-/// Whether the block reductions run their team forms by default: on a device (BlockColumnStatistics says why).
+/// Whether the block reductions run their team forms by default: on a device, where a team is block_team_warps
+/// warps, one (block, column) pair each; on the host one thread, one pair per team (team_block_statistic's form, the
+/// tests' check of the warps' sums).
 template <class MemSpace>
 constexpr bool block_teams_by_default = !Kokkos::SpaceAccessibility<Kokkos::HostSpace, MemSpace>::accessible;
 
+/// The team policy of the block reductions' team forms (their operator() tagged BlockTeams) over `pairs` (block,
+/// column) pairs.
+template <class ExecSpace>
+Kokkos::TeamPolicy<ExecSpace, BlockTeams> block_team_policy(const ExecSpace& space, int pairs) {
+  if constexpr (block_teams_by_default<typename ExecSpace::memory_space>)
+    return Kokkos::TeamPolicy<ExecSpace, BlockTeams>(space, (pairs + block_team_warps - 1) / block_team_warps,
+                                                     block_team_warps * moment_lanes);
+  else
+    return Kokkos::TeamPolicy<ExecSpace, BlockTeams>(space, pairs, 1)
+        .set_scratch_size(0, Kokkos::PerTeam(block_team_scratch_bytes));
+}
+
 /// The BlockStatistic of column c of C over block b is blocks(b, c) (count), blocks(b, C + c) (mean) and
-/// blocks(b, 2 C + c) (m2): the layout merge_block_statistics reads, each of its sums a run over the columns.
+/// blocks(b, 2 C + c) (m2); the block's count of counted column s is blocks(b, 3 C + s) (BlockColumnStatistics'
+/// Counted). The layout merge_block_statistics reads, each of its sums a run over the columns.
 template <class MemSpace>
 using BlockStatistics = Kokkos::View<double**, Kokkos::LayoutRight, MemSpace>;
 
@@ -163,9 +256,8 @@ KOKKOS_INLINE_FUNCTION int block_end(const int b, const int members) {
 }
 
 template <class MemSpace>
-KOKKOS_INLINE_FUNCTION void store_block_statistic(const BlockStatistics<MemSpace>& blocks, const int b, const int c,
-                                                  const BlockStatistic& s) {
-  const int columns = static_cast<int>(blocks.extent(1)) / 3;
+KOKKOS_INLINE_FUNCTION void store_block_statistic(const BlockStatistics<MemSpace>& blocks, const int columns,
+                                                  const int b, const int c, const BlockStatistic& s) {
   blocks(b, c) = s.count;
   blocks(b, columns + c) = s.mean;
   blocks(b, 2 * columns + c) = s.m2;
@@ -207,32 +299,75 @@ struct ColumnAddresses {
   }
 };
 
+/// What block reductions count besides their moments: counted(s, m) says whether member m counts in counted column
+/// s, of counted.columns() (filters' divergences: NotOkMembers, kernels/filters/filter_metrics.hpp). Here: nothing.
+struct NothingCounted {
+  KOKKOS_INLINE_FUNCTION int columns() const { return 0; }
+  KOKKOS_INLINE_FUNCTION bool operator()(int, int) const { return false; }
+};
+
 /// The BlockStatistic of every (block, column) pair of `columns` (columns(c): column c's values, value(m)), pair
-/// i = c * blocks + b: a column's blocks are independent, and a GPU needs the threads (one thread per block gave
-/// 1e6 members 3907 threads, and the moments took most of an output step). Two forms, the same bits: one thread per
-/// pair (the host's: its lanes are vector lanes), or a team per pair (block_team_policy: a GPU's, where one thread
-/// per pair walks its block alone, 32 threads of a warp 32 blocks apart; that form took 123 us for 12 columns of
-/// 1e6 members on an H100, 2.4x a read of them).
-template <class Columns, class MemSpace>
+/// i = c * blocks + b, and after them the count of every (block, counted column s) pair, i = (num_columns + s) *
+/// blocks + b: one launch for all of an output step's reductions. A column's blocks are independent, and a GPU needs
+/// the threads (one thread per block gave 1e6 members 3907 threads, and the moments took most of an output step).
+/// Two forms, the same bits: one thread per pair (the host's: its lanes are vector lanes), or teams (block_team_policy:
+/// on a GPU a warp per pair, warp_block_statistic; with one thread per pair a GPU's warp read 32 blocks 2 KB apart,
+/// 123 us for 12 columns of 1e6 members on an H100, 2.4x a read of them). Counts are integer sums: any order gives
+/// the same count.
+template <class Columns, class MemSpace, class Counted = NothingCounted>
 struct BlockColumnStatistics {
   Columns columns;
+  int num_columns;
+  Counted counted;
   int members;
-  BlockStatistics<MemSpace> blocks;
+  BlockStatistics<MemSpace> blocks;  // (block, 3 num_columns + counted.columns())
 
   KOKKOS_INLINE_FUNCTION void operator()(const int i) const {
     const int num_blocks = static_cast<int>(blocks.extent(0)), b = i % num_blocks, c = i / num_blocks;
-    store_block_statistic(blocks, b, c, block_statistic(columns(c), b * moment_block_size, block_end(b, members)));
+    const int begin = b * moment_block_size, end = block_end(b, members);
+    if (c < num_columns) {
+      store_block_statistic(blocks, num_columns, b, c, block_statistic(columns(c), begin, end));
+    } else {
+      int count = 0;
+      for (int m = begin; m < end; ++m) count += counted(c - num_columns, m) ? 1 : 0;
+      blocks(b, 2 * num_columns + c) = count;
+    }
   }
 
   template <class Team>
   KOKKOS_INLINE_FUNCTION void operator()(BlockTeams, const Team& team) const {
-    const int i = team.league_rank();
-    const int num_blocks = static_cast<int>(blocks.extent(0)), b = i % num_blocks, c = i / num_blocks;
-    const std::ptrdiff_t bytes = block_team_scratch_bytes;  // a copy: get_shmem takes a reference
-    double* lanes = static_cast<double*>(team.team_shmem().get_shmem(bytes));
-    const BlockStatistic s =
-        team_block_statistic(team, columns(c), b * moment_block_size, block_end(b, members), lanes);
-    Kokkos::single(Kokkos::PerTeam(team), [&]() { store_block_statistic(blocks, b, c, s); });
+    const int num_blocks = static_cast<int>(blocks.extent(0));
+#if KUSHNER_CUDA_DEVICE_PASS
+    if constexpr (block_teams_by_default<MemSpace>) {  // a pair per warp: no team barrier, only shuffles
+      const int i = team.league_rank() * block_team_warps + team.team_rank() / moment_lanes;
+      const int j = team.team_rank() % moment_lanes, b = i % num_blocks, c = i / num_blocks;
+      if (c >= num_columns + counted.columns()) return;  // the whole warp: the last team's spare warps
+      const int begin = b * moment_block_size, end = block_end(b, members);
+      if (c < num_columns) {
+        const BlockStatistic s = warp_block_statistic(j, columns(c), begin, end);
+        if (j == 0) store_block_statistic(blocks, num_columns, b, c, s);
+      } else {
+        const int s = c - num_columns;
+        const int count = warp_block_count(
+            j, [&](const int m) { return counted(s, m); }, begin, end);
+        if (j == 0) blocks(b, 2 * num_columns + c) = count;
+      }
+      return;
+    }
+#endif
+    const int i = team.league_rank(), b = i % num_blocks, c = i / num_blocks;
+    const int begin = b * moment_block_size, end = block_end(b, members);
+    if (c < num_columns) {
+      const std::ptrdiff_t bytes = block_team_scratch_bytes;  // a copy: get_shmem takes a reference
+      double* scratch = static_cast<double*>(team.team_shmem().get_shmem(bytes));
+      const BlockStatistic s = team_block_statistic(team, columns(c), begin, end, scratch);
+      Kokkos::single(Kokkos::PerTeam(team), [&]() { store_block_statistic(blocks, num_columns, b, c, s); });
+    } else {
+      const int s = c - num_columns;
+      const int count = team_block_count(
+          team, [&](const int m) { return counted(s, m); }, begin, end);
+      Kokkos::single(Kokkos::PerTeam(team), [&]() { blocks(b, 2 * num_columns + c) = count; });
+    }
   }
 };
 
@@ -252,15 +387,22 @@ struct EnsembleMoments {
   long members = 0;              // members of every rank, finite or not
 };
 
-/// Every rank's block statistics (`local`: this rank's `size` doubles of host rows), merged per column into one
-/// EnsembleMoments per column: the count, the mean sum_b n_b mean_b / n, then m2 = sum_b (m2_b + n_b (mean_b -
-/// mean)^2), each sum over the blocks in order. The rows of all ranks, in rank order, are the blocks of the whole
+/// merge_block_statistics' result: per column its moments, per counted column its count, over every rank.
+struct MergedBlocks {
+  std::vector<EnsembleMoments> moments;
+  std::vector<long> counts;
+};
+
+/// Every rank's block rows (`local`: this rank's `size` doubles of host rows, `columns` block statistics and
+/// `counted` counts per row: BlockStatistics' layout), merged per column into one EnsembleMoments per column: the
+/// count, the mean sum_b n_b mean_b / n, then m2 = sum_b (m2_b + n_b (mean_b - mean)^2), each sum over the blocks in
+/// order; and the counts summed (integers: exact). The rows of all ranks, in rank order, are the blocks of the whole
 /// ensemble in member order, so the result is the same bits for any number of ranks. No division per block (Chan et
 /// al.'s pairwise update has two, on the chain from one block to the next: 115 us for 3907 blocks of 12 columns on
 /// the host, a third of a GPU bank's output step); each sum runs over the columns side by side.
-inline std::vector<EnsembleMoments> merge_block_statistics(const double* local, std::size_t size, int columns,
-                                                           long members) {
-  const int width = 3 * columns;
+inline MergedBlocks merge_block_statistics(const double* local, std::size_t size, int columns, int counted,
+                                           long members) {
+  const int width = 3 * columns + counted;
   std::vector<double> gathered;  // one process reads its own rows, uncopied (1 MB: 1e6 members, 12 columns)
   const double* all = local;
   std::size_t all_size = size;
@@ -271,13 +413,14 @@ inline std::vector<EnsembleMoments> merge_block_statistics(const double* local, 
   }
   const long all_blocks = static_cast<long>(all_size) / width;
   const long all_members = collective::sum(members);
-  std::vector<double> count(columns, 0.0), mean(columns, 0.0), m2(columns, 0.0);
+  std::vector<double> count(columns, 0.0), mean(columns, 0.0), m2(columns, 0.0), counts(counted, 0.0);
   for (long b = 0; b < all_blocks; ++b) {
     const double* row = all + b * width;
     for (int c = 0; c < columns; ++c) {
       count[c] += row[c];
       mean[c] += row[c] * row[columns + c];  // an empty block's mean is 0
     }
+    for (int s = 0; s < counted; ++s) counts[s] += row[3 * columns + s];
   }
   for (int c = 0; c < columns; ++c) mean[c] /= count[c];
   for (long b = 0; b < all_blocks; ++b) {
@@ -287,12 +430,13 @@ inline std::vector<EnsembleMoments> merge_block_statistics(const double* local, 
       m2[c] += row[c] > 0.0 ? row[2 * columns + c] + row[c] * (delta * delta) : 0.0;
     }
   }
-  std::vector<EnsembleMoments> result;
+  MergedBlocks result;
   for (int c = 0; c < columns; ++c)
-    result.push_back({{count[c] > 0 ? mean[c] : std::numeric_limits<double>::quiet_NaN()},
-                      {count[c] > 1 ? m2[c] / (count[c] - 1) : std::numeric_limits<double>::quiet_NaN()},
-                      all_members - static_cast<long>(count[c]),
-                      all_members});
+    result.moments.push_back({{count[c] > 0 ? mean[c] : std::numeric_limits<double>::quiet_NaN()},
+                              {count[c] > 1 ? m2[c] / (count[c] - 1) : std::numeric_limits<double>::quiet_NaN()},
+                              all_members - static_cast<long>(count[c]),
+                              all_members});
+  for (int s = 0; s < counted; ++s) result.counts.push_back(static_cast<long>(counts[s]));
   return result;
 }
 
@@ -308,10 +452,11 @@ EnsembleMoments ensemble_moments(const ExecSpace& space, const View& x) {
   BlockStatistics<MemSpace> blocks(Kokkos::view_alloc(space, Kokkos::WithoutInitializing, "kushner::moment_blocks"),
                                    num_blocks, 3 * columns);
   launch_block_statistics("kushner::block_moments", space, num_blocks * columns, block_teams_by_default<MemSpace>,
-                          BlockColumnStatistics<FiniteRows<View>, MemSpace>{{x}, members, blocks});
+                          BlockColumnStatistics<FiniteRows<View>, MemSpace>{{x}, columns, {}, members, blocks});
   space.fence();
   const auto rows = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), blocks);
-  const std::vector<EnsembleMoments> per_column = merge_block_statistics(rows.data(), rows.size(), columns, members);
+  const std::vector<EnsembleMoments> per_column =
+      merge_block_statistics(rows.data(), rows.size(), columns, 0, members).moments;
   // Every rank has the same columns, so every rank takes the same branch of this collective call.
   const long all_members = per_column.empty() ? collective::sum(members) : per_column.front().members;
   EnsembleMoments result{{}, {}, all_members, all_members};
@@ -328,9 +473,10 @@ EnsembleMoments ensemble_moments(const ExecSpace& space, const View& x) {
 namespace kushner {
 
 /// ensemble_moments of each of `columns` (contiguous member-indexed columns of equal length, e.g. subviews (ALL, c)
-/// of LayoutLeft banks), bit for bit, in one pass over the blocks and one gather over the ranks. Keeps its device
-/// and host buffers from call to call (a bank's output steps call it with the same columns every time): on a GPU an
-/// allocation and its release each wait for the device.
+/// of LayoutLeft banks), bit for bit, and optionally counts of members (a Counted of BlockColumnStatistics), in one
+/// launch over the blocks, one copy and one gather over the ranks. Keeps its device and host buffers from call to
+/// call (a bank's output steps call it with the same columns every time): on a GPU an allocation and its release
+/// each wait for the device.
 template <class ExecSpace>
 class ColumnMoments {
  public:
@@ -342,13 +488,16 @@ class ColumnMoments {
 
   std::vector<EnsembleMoments> operator()(const ExecSpace& space, const std::vector<Column>& columns) {
     start(space, columns);
-    return finish();
+    return finish().moments;
   }
 
-  /// Queues the moments of `columns` on `space`: the kernel and, on a GPU, the copy of its rows to the host.
-  /// finish() waits for them and merges.
-  void start(const ExecSpace& space, const std::vector<Column>& columns) {
+  /// Queues the moments of `columns` and the counts of `counted` over the same members on `space`: the kernel and,
+  /// on a GPU, the copy of its rows to the host. finish() waits for them and merges.
+  template <class Counted = NothingCounted>
+  void start(const ExecSpace& space, const std::vector<Column>& columns, const Counted& counted = {}) {
     num_columns_ = static_cast<int>(columns.size());
+    num_counted_ = counted.columns();
+    KUSHNER_REQUIRE(num_columns_ > 0 || num_counted_ == 0, "column_moments: counts without a column");
     if (num_columns_ == 0) return;
     members_ = static_cast<int>(columns.front().extent(0));
     const int num_blocks = static_cast<int>(moment_blocks(members_));
@@ -359,26 +508,27 @@ class ColumnMoments {
       addresses.push_back(reinterpret_cast<std::uintptr_t>(columns[c].data()));
     }
     const auto& pointers = columns_.update(space, addresses);
+    const int width = 3 * num_columns_ + num_counted_;
     if (blocks_.extent(0) != static_cast<std::size_t>(num_blocks) ||
-        blocks_.extent(1) != static_cast<std::size_t>(3 * num_columns_)) {
-      blocks_ =
-          BlockStatistics<MemSpace>(Kokkos::view_alloc(space, Kokkos::WithoutInitializing, "kushner::moment_blocks"),
-                                    num_blocks, 3 * num_columns_);
+        blocks_.extent(1) != static_cast<std::size_t>(width)) {
+      blocks_ = BlockStatistics<MemSpace>(
+          Kokkos::view_alloc(space, Kokkos::WithoutInitializing, "kushner::moment_blocks"), num_blocks, width);
       // The blocks themselves in host memory; a page-locked copy of them on a GPU.
       rows_ = Kokkos::create_mirror_view(typename HostStaging<MemSpace>::space(), blocks_);
     }
-    launch_block_statistics("kushner::block_column_moments", space, num_blocks * num_columns_, teams_,
-                            BlockColumnStatistics<ColumnAddresses<MemSpace>, MemSpace>{{pointers}, members_, blocks_});
+    launch_block_statistics("kushner::block_column_moments", space, num_blocks * (num_columns_ + num_counted_), teams_,
+                            BlockColumnStatistics<ColumnAddresses<MemSpace>, MemSpace, Counted>{
+                                {pointers}, num_columns_, counted, members_, blocks_});
     if (rows_.data() != blocks_.data()) Kokkos::deep_copy(space, rows_, blocks_);
     done_.record(space);
   }
 
-  /// The moments start() queued, per column, over every rank (a collective call). Waits for start()'s work only, not
-  /// for what was queued on the space after it.
-  std::vector<EnsembleMoments> finish() {
+  /// The moments and counts start() queued, per column, over every rank (a collective call). Waits for start()'s work
+  /// only, not for what was queued on the space after it.
+  MergedBlocks finish() {
     if (num_columns_ == 0) return {};
     done_.wait();
-    return merge_block_statistics(rows_.data(), rows_.size(), num_columns_, members_);
+    return merge_block_statistics(rows_.data(), rows_.size(), num_columns_, num_counted_, members_);
   }
 
  private:
@@ -387,8 +537,8 @@ class ColumnMoments {
   BlockStatistics<MemSpace> blocks_;
   HostRows rows_;  // blocks_ (on the host) or its page-locked copy
   bool teams_;
-  int num_columns_ = 0, members_ = 0;  // of the last start()
-  QueueMark<ExecSpace> done_;          // after the last start()'s copy
+  int num_columns_ = 0, num_counted_ = 0, members_ = 0;  // of the last start()
+  QueueMark<ExecSpace> done_;                            // after the last start()'s copy
 };
 
 }  // namespace kushner

@@ -43,6 +43,36 @@ void BM_FilterBankStep(benchmark::State& state) {
   state.SetLabel(label);
 }
 
+/// The command line's bank (`kushner filter --filters EKF,SOF,QLF,KBL`) with every step an output step, as
+/// engine/filter_run.hpp runs it: the step, then its reductions queued (start_snapshots) and collected once the next
+/// step is queued (finish_snapshots). Arg 1 = 0: the same steps with no output (what an output step adds is the
+/// difference of the two).
+template <class Model>
+void BM_FilterBankOutputSteps(benchmark::State& state) {
+  const long members = state.range(0);
+  const bool output = state.range(1) != 0;
+  const Space space;
+  const std::vector<std::string> filters{"EKF", "SOF", "QLF", "KBL"};
+  FilterBank<Space, Model> bank(space, Model{}, Model{}, members, 42, filters);
+  long k = 0;
+  bool pending = false;
+  for (auto _ : state) {
+    space.fence();
+    Kokkos::Timer timer;
+    bank.step(k++, 1e-3, output);
+    if (pending) bank.finish_snapshots();
+    if (output) bank.start_snapshots(filters);
+    pending = output;
+    space.fence();
+    state.SetIterationTime(timer.seconds());
+  }
+  if (pending) bank.finish_snapshots();
+  using C = benchmark::Counter;
+  state.counters["member_steps_per_s"] = C(static_cast<double>(members), C::kIsIterationInvariantRate);
+  for (const auto& name : filters)
+    if (bank.scores(name, k + 1).diverged > 0) state.SkipWithError(("diverged members in " + name).c_str());
+}
+
 /// The baseline: the same truths stepped alone (what `kushner simulate` does per step).
 template <class Model>
 void BM_TruthStepAlone(benchmark::State& state) {
@@ -66,6 +96,11 @@ BENCHMARK_TEMPLATE(BM_FilterBankStep, SineModel)
     ->Arg(10000)
     ->Arg(100000)
     ->Arg(1000000)
+    ->UseManualTime();
+BENCHMARK_TEMPLATE(BM_FilterBankOutputSteps, SineModel)
+    ->ArgNames({"members", "output"})
+    ->Args({1000000, 1})
+    ->Args({1000000, 0})
     ->UseManualTime();
 BENCHMARK_TEMPLATE(BM_TruthStepAlone, SineModel)
     ->ArgName("members")

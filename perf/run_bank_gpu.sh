@@ -9,11 +9,21 @@
 #   profile time per kernel and copy of one run (T = 0.05, 1e6 members), with perf/kokkos_kernel_timer.cpp and
 #          CUDA_LAUNCH_BLOCKING=1 (no profiler is installed on the GPU machine)
 #   OUT=<dir> KUSHNER_PHASES="build run" perf/run_bank_gpu.sh
+#   ab     this tree against a baseline tree (KUSHNER_BANK_BASELINE, e.g. .baseline below, given this tree's
+#          perf/bench_filter_bank.cpp), both built light (bench_filter_bank, and test_ensemble_moments for this tree;
+#          the models' shared instances off: a few minutes for both at once on 32 cores): test_ensemble_moments,
+#          then BM_FilterBankOutputSteps (M = 1e6, every step an output step, and no output) in alternating
+#          rounds, and the kernel timer of one run of each
+# A baseline on the same machine: another source tree (e.g. `git archive <rev>` extracted into the git-ignored
+# .baseline/, named in `carry`) built into its own directory, then its phases run as the new tree's:
+#   KUSHNER_BANK_SOURCE=.baseline KUSHNER_BANK_BUILD=build-cuda-bank-old KUSHNER_PHASES=build perf/run_bank_gpu.sh
 set -uo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 out=${OUT:-$here/bank-gpu-out}
 mkdir -p "$out"
-build=$here/build-cuda-bank
+source_tree=$(cd "${KUSHNER_BANK_SOURCE:-$here}" && pwd)
+build=$here/${KUSHNER_BANK_BUILD:-build-cuda-bank}
+[ -e "$source_tree/.deps" ] || ln -s "$here/.deps" "$source_tree/.deps"
 phases=" ${KUSHNER_PHASES:-build run} "
 want() { [[ "$phases" == *" $1 "* ]]; }
 export PATH=/usr/local/cuda/bin:$PATH OMP_PROC_BIND=false CMAKE_POLICY_VERSION_MINIMUM=3.5
@@ -23,7 +33,7 @@ nvidia-smi --query-gpu=name,memory.total,power.limit,clocks.max.sm,driver_versio
 
 if want build; then
   log "configure"
-  cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON -DKUSHNER_ENABLE_OPENMP=OFF \
+  cmake -S "$source_tree" -B "$build" -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON -DKUSHNER_ENABLE_OPENMP=OFF \
     -DKUSHNER_ENABLE_SERIAL=ON -DKUSHNER_ENABLE_MPI=OFF -DKUSHNER_COMMAND_UNITS=16 > "$out/configure.log" 2>&1 ||
     { tail -20 "$out/configure.log"; exit 1; }
   cmake --build "$build" -j"$(nproc)" --target kushner test_ensemble_moments > "$out/build.log" 2>&1 || status=1
@@ -72,6 +82,54 @@ if want profile; then
     --model sine --filters EKF,SOF,QLF,KBL --members 1000000 --T 0.05 --out "$out/profile-run" --quiet \
     2> "$out/kernel_times.txt" > /dev/null || status=1
   grep -v "View::initialization" "$out/kernel_times.txt" | tee -a "$out/steps.log"
+fi
+if want ab; then
+  old_tree=$(cd "${KUSHNER_BANK_BASELINE:?ab: KUSHNER_BANK_BASELINE names the baseline tree}" && pwd)
+  [ -e "$old_tree/.deps" ] || ln -s "$here/.deps" "$old_tree/.deps"
+  cp "$here/perf/bench_filter_bank.cpp" "$old_tree/perf/bench_filter_bank.cpp"
+  light() {  # light SRC BUILD TARGETS...
+    local src=$1 dir=$2; shift 2
+    cmake -S "$src" -B "$dir" -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON -DKUSHNER_ENABLE_OPENMP=OFF \
+      -DKUSHNER_ENABLE_SERIAL=ON -DKUSHNER_ENABLE_MPI=OFF -DKUSHNER_SHARED_INSTANCES=OFF > "$out/configure_$(basename "$dir").log" 2>&1 &&
+      cmake --build "$dir" -j16 --target "$@" > "$out/build_$(basename "$dir").log" 2>&1
+  }
+  log "ab: build $old_tree and this tree (light)"
+  light "$old_tree" "$here/build-cuda-ab-old" bench_filter_bank &
+  old_pid=$!
+  light "$here" "$here/build-cuda-ab-new" bench_filter_bank test_ensemble_moments || { status=1; echo "new build failed"; }
+  wait $old_pid || { status=1; echo "old build failed"; }
+  grep -h -B2 -A10 -m3 " error" "$out"/build_build-cuda-ab-*.log | head -40
+  log "ab: built"
+  "$here/build-cuda-ab-new/tests/test_ensemble_moments" > "$out/ab_test_ensemble_moments.log" 2>&1 || status=1
+  grep -E "^\[  (PASSED|FAILED)|FAILED \]" "$out/ab_test_ensemble_moments.log" | tee -a "$out/steps.log"
+  for round in 1 2 3; do
+    for which in old new; do
+      "$here/build-cuda-ab-$which/perf/bench_filter_bank" --benchmark_filter=BM_FilterBankOutputSteps \
+        --benchmark_repetitions=3 --benchmark_out="$out/ab-$which-$round.json" > /dev/null 2>&1 || status=1
+    done
+  done
+  python3 - "$out" <<'PY' | tee -a "$out/steps.log"
+import collections, glob, json, statistics, sys
+rates = collections.defaultdict(list)
+for path in sorted(glob.glob(sys.argv[1] + "/ab-*-*.json")):
+    which = path.split("/")[-1].split("-")[1]
+    for b in json.load(open(path))["benchmarks"]:
+        if b.get("run_type") == "iteration" and "member_steps_per_s" in b:
+            rates[(b["run_name"], which)].append(b["member_steps_per_s"])
+for name in sorted({n for n, _ in rates}):
+    old, new = statistics.median(rates[(name, "old")]), statistics.median(rates[(name, "new")])
+    print("%s: old %.3g, new %.3g member-steps/s (medians of %d, %d): new / old %.3f" %
+          (name, old, new, len(rates[(name, "old")]), len(rates[(name, "new")]), new / old))
+PY
+  g++ -O2 -shared -fPIC "$here/perf/kokkos_kernel_timer.cpp" -o "$out/kernel_timer.so" || status=1
+  for which in old new; do
+    log "ab: kernel timer, $which (CUDA_LAUNCH_BLOCKING=1, every step an output step)"
+    CUDA_LAUNCH_BLOCKING=1 KOKKOS_PROFILE_LIBRARY="$out/kernel_timer.so" \
+      "$here/build-cuda-ab-$which/perf/bench_filter_bank" --benchmark_filter='BM_FilterBankOutputSteps.*output:1' \
+      2> "$out/ab_kernel_times_$which.txt" > /dev/null || status=1
+    grep -v "View::initialization" "$out/ab_kernel_times_$which.txt" | tee -a "$out/steps.log"
+  done
+  rm -f "$out/kernel_timer.so"
 fi
 log "done (status $status)"
 exit $status

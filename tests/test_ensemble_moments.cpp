@@ -115,21 +115,26 @@ TYPED_TEST(EnsembleMomentsTest, ColumnMomentsEqualEachColumnsEnsembleMoments) {
     }
 }
 
-/// DivergedCounts: for each status column, count_status of not_positive_definite plus that of non_finite among the
-/// members whose truth is ok, in one pass (and again with its kept device list).
-TYPED_TEST(EnsembleMomentsTest, DivergedCountsEqualTheStatusCounts) {
+/// The divergence counts in the moments' launch (ColumnMoments with NotOkMembers): for each status column,
+/// count_status of not_positive_definite plus that of non_finite among the members whose truth is ok, in both forms
+/// of the kernel, again with its kept buffers and device lists, and with other columns; the moments beside them
+/// are the bits of the moments alone.
+TYPED_TEST(EnsembleMomentsTest, DivergenceCountsInTheMomentsLaunchEqualTheStatusCounts) {
   using MemSpace = typename TypeParam::memory_space;
-  const int members = 777;
+  const int members = 777;  // three blocks and a short one
   Kokkos::View<Status*, Kokkos::LayoutLeft, Kokkos::HostSpace> truth("truth", members), a("a", members),
       b("b", members);
+  Kokkos::View<double*, Kokkos::HostSpace> values("values", members);
   for (int m = 0; m < members; ++m) {
     truth(m) = m % 50 == 3 ? Status::non_finite : Status::ok;
     a(m) = m % 7 == 0 ? Status::not_positive_definite : m % 11 == 0 ? Status::non_finite : Status::ok;
     b(m) = m % 3 == 0 ? Status::non_finite : Status::ok;
+    values(m) = m % 13 == 0 ? std::numeric_limits<double>::quiet_NaN() : std::cos(0.1 * m);
   }
   const BankScalar<Status, MemSpace> truth_d = Kokkos::create_mirror_view_and_copy(MemSpace(), truth);
   const BankScalar<Status, MemSpace> a_d = Kokkos::create_mirror_view_and_copy(MemSpace(), a);
   const BankScalar<Status, MemSpace> b_d = Kokkos::create_mirror_view_and_copy(MemSpace(), b);
+  const Kokkos::View<const double*, MemSpace> column = Kokkos::create_mirror_view_and_copy(MemSpace(), values);
   long expected_a = 0, expected_b = 0;
   for (int m = 0; m < members; ++m) {
     expected_a += truth(m) == Status::ok && a(m) != Status::ok;
@@ -137,10 +142,24 @@ TYPED_TEST(EnsembleMomentsTest, DivergedCountsEqualTheStatusCounts) {
   }
   EXPECT_EQ(expected_a, count_status(TypeParam(), a_d, Status::not_positive_definite, truth_d) +
                             count_status(TypeParam(), a_d, Status::non_finite, truth_d));
-  DivergedCounts<TypeParam> counts;
-  for (int repeat = 0; repeat < 2; ++repeat)
-    EXPECT_EQ(counts(TypeParam(), {a_d, b_d, a_d}, truth_d), (std::vector<long>{expected_a, expected_b, expected_a}));
-  EXPECT_EQ(counts(TypeParam(), {b_d}, truth_d), std::vector<long>{expected_b});
+  for (const bool teams : {false, true}) {
+    ColumnMoments<TypeParam> moments(teams);
+    const EnsembleMoments alone = moments(TypeParam(), {column}).front();
+    DivergedMembers<MemSpace> diverged;
+    for (int repeat = 0; repeat < 2; ++repeat) {
+      moments.start(TypeParam(), {column, column}, diverged(TypeParam(), {a_d, b_d, a_d}, truth_d));
+      const MergedBlocks merged = moments.finish();
+      EXPECT_EQ(merged.counts, (std::vector<long>{expected_a, expected_b, expected_a})) << "teams " << teams;
+      ASSERT_EQ(merged.moments.size(), 2u);
+      for (const auto& mo : merged.moments) {
+        EXPECT_EQ(mo.mean, alone.mean) << "teams " << teams;
+        EXPECT_EQ(mo.variance, alone.variance) << "teams " << teams;
+        EXPECT_EQ(mo.non_finite, alone.non_finite) << "teams " << teams;
+      }
+    }
+    moments.start(TypeParam(), {column}, diverged(TypeParam(), {b_d}, truth_d));
+    EXPECT_EQ(moments.finish().counts, std::vector<long>{expected_b}) << "teams " << teams;
+  }
 }
 
 /// The MPI split: shares cover the members in order, start on block boundaries (so that every rank's blocks are

@@ -10,8 +10,6 @@
 #include "kernels/device_addresses.hpp"
 #include "kernels/ensemble_moments.hpp"
 #include "kernels/filters/filter_slot.hpp"
-#include "kernels/host_copy.hpp"
-#include "kernels/queue_mark.hpp"
 
 #include <Kokkos_Core.hpp>
 
@@ -71,77 +69,41 @@ long count_status(const ExecSpace& space, const BankScalar<Status, MemSpace>& st
   return collective::sum(count);  // over every rank's members
 }
 
-/// counts(s) = members whose truth is ok and whose status in column s is not: one thread per member, an atomic add
-/// where a member counts (a diverged filter: rare). Integer adds, so any order gives the same count. (For 1e6
-/// members and 4 filters on an H100: a Kokkos array reduction over members took 197 us per call, a thread per
-/// 256-member block and column 64 us, a team per block and column 46 us on an H200.)
+/// The divergences of a bank's filters as a Counted of its snapshot moments (BlockColumnStatistics, ColumnMoments):
+/// member m counts in column s where its truth is ok and status column s is not, so a column's count is count_status
+/// of not_positive_definite plus that of non_finite among the members whose truth is ok. Counted in the moments'
+/// launch, per block, and summed with their rows: no launch, zeroing or atomic add of their own (on an H200, 1e6
+/// members, 4 filters: a separate kernel with atomic adds took 24 us per output step and its zeroing 13 us).
 template <class MemSpace>
-struct NotOkCounts {
+struct NotOkMembers {
   Kokkos::View<const std::uintptr_t*, MemSpace> statuses;  // column s at (const Status*) statuses(s)
   BankScalar<Status, MemSpace> truth_status;
-  Kokkos::View<int*, MemSpace> counts;
 
-  KOKKOS_INLINE_FUNCTION void operator()(const int m) const {
-    if (truth_status(m) != Status::ok) return;
-    for (int s = 0; s < static_cast<int>(counts.extent(0)); ++s)
-      if (reinterpret_cast<const Status*>(statuses(s))[m] != Status::ok) Kokkos::atomic_increment(&counts(s));
+  KOKKOS_INLINE_FUNCTION int columns() const { return static_cast<int>(statuses.extent(0)); }
+  KOKKOS_INLINE_FUNCTION bool operator()(const int s, const int m) const {
+    const Status truth = truth_status(m), status = reinterpret_cast<const Status*>(statuses(s))[m];  // both read:
+    return (truth == Status::ok) & (status != Status::ok);  // no branch between the reads (warp_block_count)
   }
 };
 
-/// For each of `statuses` (filters of one bank): count_status of not_positive_definite plus that of non_finite
-/// among the members whose truth is ok, over every rank; one kernel (after zeroing the counters) and one copy for all
-/// of them. Keeps its device list of the columns and its buffers from call to call, like ColumnMoments.
-template <class ExecSpace>
-class DivergedCounts {
+/// NotOkMembers of status columns of one bank; keeps its device list of the columns from call to call (a bank
+/// counts the same columns at every output step).
+template <class MemSpace>
+class DivergedMembers {
  public:
-  using MemSpace = typename ExecSpace::memory_space;
-
-  std::vector<long> operator()(const ExecSpace& space, const std::vector<BankScalar<Status, MemSpace>>& statuses,
-                               const BankScalar<Status, MemSpace>& truth_status) {
-    start(space, statuses, truth_status);
-    return finish();
-  }
-
-  /// Queues the counts on `space` (kernel and copy to the host), like ColumnMoments::start; finish() waits and sums.
-  void start(const ExecSpace& space, const std::vector<BankScalar<Status, MemSpace>>& statuses,
-             const BankScalar<Status, MemSpace>& truth_status) {
-    columns_count_ = static_cast<int>(statuses.size());
-    if (columns_count_ == 0) return;
+  template <class ExecSpace>
+  NotOkMembers<MemSpace> operator()(const ExecSpace& space, const std::vector<BankScalar<Status, MemSpace>>& statuses,
+                                    const BankScalar<Status, MemSpace>& truth_status) {
     std::vector<std::uintptr_t> addresses;
     for (const auto& s : statuses) {
-      KUSHNER_REQUIRE(s.extent(0) == truth_status.extent(0), "DivergedCounts: a status column of another bank");
+      KUSHNER_REQUIRE(s.extent(0) == truth_status.extent(0), "DivergedMembers: a status column of another bank");
       addresses.push_back(reinterpret_cast<std::uintptr_t>(s.data()));
     }
-    if (counts_.extent(0) != statuses.size()) {
-      counts_ = Kokkos::View<int*, MemSpace>(Kokkos::view_alloc(space, "kushner::diverged_counts"), columns_count_);
-      // The counts themselves in host memory; a page-locked copy of them on a GPU.
-      host_ = Kokkos::create_mirror_view(typename HostStaging<MemSpace>::space(), counts_);
-    }
-    Kokkos::deep_copy(space, counts_, 0);
-    Kokkos::parallel_for("kushner::diverged_counts",
-                         Kokkos::RangePolicy<ExecSpace>(space, 0, static_cast<long>(truth_status.extent(0))),
-                         NotOkCounts<MemSpace>{columns_.update(space, addresses), truth_status, counts_});
-    if (host_.data() != counts_.data()) Kokkos::deep_copy(space, host_, counts_);
-    done_.record(space);
-  }
-
-  /// The counts start() queued, per status column, over every rank (a collective call); like
-  /// ColumnMoments::finish, waits for start()'s work only.
-  std::vector<long> finish() {
-    std::vector<long> totals(columns_count_, 0);
-    if (columns_count_ == 0) return totals;
-    done_.wait();
-    for (int s = 0; s < columns_count_; ++s) totals[s] = collective::sum(static_cast<long>(host_(s)));
-    return totals;
+    return {columns_.update(space, addresses), truth_status};
   }
 
  private:
-  using HostCounts = Kokkos::View<int*, typename HostStaging<MemSpace>::space>;
   DeviceAddresses<MemSpace> columns_;
-  Kokkos::View<int*, MemSpace> counts_;
-  HostCounts host_;
-  int columns_count_ = 0;  // of the last start()
-  QueueMark<ExecSpace> done_;
 };
 
 }  // namespace kushner
