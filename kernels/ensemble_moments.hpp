@@ -20,6 +20,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <type_traits>
 #include <vector>
 
 namespace kushner {
@@ -264,23 +265,29 @@ KOKKOS_INLINE_FUNCTION void store_block_statistic(const BlockStatistics<MemSpace
 }
 
 /// Column c of x where every column of the member's row is finite, NaN elsewhere: ensemble_moments leaves a
-/// member with any non-finite entry out of every column.
-template <class View>
+/// member with any non-finite entry out of every column. `Columns`: x's number of columns, where known at compile
+/// time (-1: x.extent(1)).
+template <class View, int Columns = -1>
 struct FiniteRowValue {
   View x;
   int column;
   KOKKOS_INLINE_FUNCTION double operator()(const int m) const {
-    bool finite = true;
-    for (int c = 0; c < static_cast<int>(x.extent(1)); ++c) finite = finite && math::is_finite(x(m, c));
-    return finite ? x(m, column) : math::quiet_nan();
+    // x * 0 is 0 for a finite x and NaN for an infinite or NaN one, so `poison` is NaN exactly where the row has a
+    // non-finite entry, and adding it changes nothing else (a -0 becomes +0, which adds the same to every sum of
+    // block_statistic). Arithmetic with a compile-time count, not a chain of bools: only so do the host's lanes
+    // vectorize (2 columns of 1e6 members, both passes: 0.9 ms against 10 ms on the development machine).
+    const int columns = Columns >= 0 ? Columns : static_cast<int>(x.extent(1));
+    double poison = 0.0;
+    for (int c = 0; c < columns; ++c) poison += x(m, c) * 0.0;
+    return x(m, column) + poison;
   }
 };
 
 /// The columns of a bank x(member, column), each as FiniteRowValue (ensemble_moments).
-template <class View>
+template <class View, int Columns = -1>
 struct FiniteRows {
   View x;
-  KOKKOS_INLINE_FUNCTION FiniteRowValue<View> operator()(const int c) const { return {x, c}; }
+  KOKKOS_INLINE_FUNCTION FiniteRowValue<View, Columns> operator()(const int c) const { return {x, c}; }
 };
 
 /// A contiguous member-indexed column at a device address.
@@ -451,8 +458,18 @@ EnsembleMoments ensemble_moments(const ExecSpace& space, const View& x) {
   // join per call cost more than the moments (kushner reproduce's one-member runs).
   BlockStatistics<MemSpace> blocks(Kokkos::view_alloc(space, Kokkos::WithoutInitializing, "kushner::moment_blocks"),
                                    num_blocks, 3 * columns);
-  launch_block_statistics("kushner::block_moments", space, num_blocks * columns, block_teams_by_default<MemSpace>,
-                          BlockColumnStatistics<FiniteRows<View>, MemSpace>{{x}, columns, {}, members, blocks});
+  const auto launch = [&](auto fixed_columns) {
+    using Rows = FiniteRows<View, decltype(fixed_columns)::value>;
+    launch_block_statistics("kushner::block_moments", space, num_blocks * columns, block_teams_by_default<MemSpace>,
+                            BlockColumnStatistics<Rows, MemSpace>{{x}, columns, {}, members, blocks});
+  };
+  switch (columns) {  // the models' state sizes at compile time (FiniteRowValue)
+    case 1: launch(std::integral_constant<int, 1>{}); break;
+    case 2: launch(std::integral_constant<int, 2>{}); break;
+    case 3: launch(std::integral_constant<int, 3>{}); break;
+    case 4: launch(std::integral_constant<int, 4>{}); break;
+    default: launch(std::integral_constant<int, -1>{});
+  }
   space.fence();
   const auto rows = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), blocks);
   const std::vector<EnsembleMoments> per_column =

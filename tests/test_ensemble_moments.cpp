@@ -29,21 +29,48 @@ Kokkos::View<double**, Kokkos::LayoutLeft, Kokkos::HostSpace> sample_bank() {
   return x;
 }
 
+/// Expects `moments` to be, column by column, the direct two-pass mean and sample variance of `host` over every
+/// member but `left_out` and `also_left_out`.
+void expect_two_pass_moments(const Kokkos::View<double**, Kokkos::LayoutLeft, Kokkos::HostSpace>& host,
+                             const EnsembleMoments& moments, int left_out, int also_left_out) {
+  const int members = static_cast<int>(host.extent(0)), columns = static_cast<int>(host.extent(1));
+  const auto kept = [&](int m) { return m != left_out && m != also_left_out; };
+  for (int c = 0; c < columns; ++c) {
+    double sum = 0.0, n = 0.0;
+    for (int m = 0; m < members; ++m)
+      if (kept(m)) sum += host(m, c), n += 1.0;
+    const double mean = sum / n;
+    double ss = 0.0;
+    for (int m = 0; m < members; ++m)
+      if (kept(m)) ss += (host(m, c) - mean) * (host(m, c) - mean);
+    EXPECT_NEAR(moments.mean[c], mean, 1e-13 * std::abs(mean)) << columns << " columns, column " << c;
+    EXPECT_NEAR(moments.variance[c], ss / (n - 1), 1e-11 * ss / (n - 1)) << columns << " columns, column " << c;
+  }
+}
+
 TYPED_TEST(EnsembleMomentsTest, MatchesTwoPassOverFiniteMembersAndCountsTheRest) {
   const auto host = sample_bank();
   auto x = Kokkos::create_mirror_view_and_copy(typename TypeParam::memory_space(), host);
   const auto moments = ensemble_moments(TypeParam(), x);
   EXPECT_EQ(moments.non_finite, 2);
-  for (int c = 0; c < 2; ++c) {
-    double sum = 0.0, n = 0.0;
-    for (int m = 0; m < 1000; ++m)
-      if (m != 17 && m != 600) sum += host(m, c), n += 1.0;
-    const double mean = sum / n;
-    double ss = 0.0;
-    for (int m = 0; m < 1000; ++m)
-      if (m != 17 && m != 600) ss += (host(m, c) - mean) * (host(m, c) - mean);
-    EXPECT_NEAR(moments.mean[c], mean, 1e-13 * std::abs(mean));
-    EXPECT_NEAR(moments.variance[c], ss / (n - 1), 1e-11 * ss / (n - 1));
+  expect_two_pass_moments(host, moments, 17, 600);
+}
+
+// Every column count ensemble_moments dispatches on (1 to 4 at compile time, more at run time): a member with a
+// non-finite entry in its last column, another in its first, are left out of every column; one with a -0 entry is
+// kept.
+TYPED_TEST(EnsembleMomentsTest, LeavesOutRowsWithANonFiniteEntryForEveryColumnCount) {
+  for (int columns = 1; columns <= 6; ++columns) {
+    Kokkos::View<double**, Kokkos::LayoutLeft, Kokkos::HostSpace> host("x", 700, columns);
+    for (int m = 0; m < 700; ++m)
+      for (int c = 0; c < columns; ++c) host(m, c) = std::sin(0.37 * m + c) + c + 2.0;
+    host(5, 0) = -0.0;
+    host(33, columns - 1) = std::numeric_limits<double>::quiet_NaN();
+    host(401, 0) = -std::numeric_limits<double>::infinity();
+    auto x = Kokkos::create_mirror_view_and_copy(typename TypeParam::memory_space(), host);
+    const auto moments = ensemble_moments(TypeParam(), x);
+    EXPECT_EQ(moments.non_finite, 2) << columns << " columns";
+    expect_two_pass_moments(host, moments, 33, 401);
   }
 }
 
