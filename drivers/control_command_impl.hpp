@@ -230,6 +230,9 @@ nlohmann::json run_controlled_model(const Model& model, const ControlOptions& op
     KUSHNER_INPUT_REQUIRE(hjb_solvable<Model>(),
                           "--reference hjb: model '" << Model::name << "' is not of dimension 1-2 with one control");
   const ParticleSettings particle = particle_settings(options);
+  KUSHNER_INPUT_REQUIRE(particle.options.precision != ParticlePrecision::fp32,
+                        "--precision fp32: not available in control (its particle filter stores particles in fp64; "
+                        "use fp64 or mixed)");
   KUSHNER_INPUT_REQUIRE(particle.step_pairs != StepPairs::always,
                         "--step-pairs always: a closed loop's particle filter takes one step at a time (each control "
                         "needs the step before)");

@@ -112,8 +112,8 @@ RunMemory run_memory(const CompareOptions& options, const std::vector<std::strin
     memory.total_bytes += Particles::bytes_needed(options.run.members, particle.particles, particle.options);
   }
   if (pairs && fuses) {
-    memory.particle_bytes_per_particle += Particles::step_pair_bytes_per_particle();
-    memory.total_bytes += Particles::step_pair_bytes_needed(options.run.members, particle.particles);
+    memory.particle_bytes_per_particle += Particles::step_pair_bytes_per_particle(particle.options);
+    memory.total_bytes += Particles::step_pair_bytes_needed(options.run.members, particle.particles, particle.options);
   }
   return memory;
 }

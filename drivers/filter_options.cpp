@@ -58,8 +58,9 @@ void add_filter_options(CLI::App& app, FilterOptions& o) {
                  "PF resamples a member when its effective sample size falls below this fraction of --particles")
       ->capture_default_str();
   app.add_option("--precision", o.precision,
-                 "PF arithmetic: fp64, or mixed (normals drawn in fp32, state, weights and sums in fp64; faster on "
-                 "GPUs)")
+                 "PF arithmetic: fp64; mixed (normals drawn in fp32, particles, weights and sums in fp64; faster on "
+                 "GPUs); or fp32 (mixed's normals, particles and log-weights stored in fp32: about half the "
+                 "memory per particle; each step computed in fp64, sums in fp64)")
       ->capture_default_str();
   app.add_option("--step-pairs", o.step_pairs,
                  "PF takes two steps per pass over its particles, the bank scoring one step behind: auto (where its "
@@ -100,14 +101,9 @@ ParticleSettings particle_settings(const FilterOptions& o) {
                                                 << "' (known: multinomial, residual, stratified, systematic)");
   settings.options.scheme = *scheme;
   settings.options.ess_threshold = o.ess_threshold;
-  // fp32 (particles and log-weights in float) is named by users who know other codes' precision switches: say
-  // why it is not there rather than only listing what is.
-  KUSHNER_INPUT_REQUIRE(o.precision != "fp32",
-                        "--precision fp32: not available (the particle filter keeps particles "
-                        "and weights in fp64; mixed draws its normals in fp32)");
   const std::optional<ParticlePrecision> precision = particle_precision_named(o.precision);
   KUSHNER_INPUT_REQUIRE(precision.has_value(),
-                        "--precision: unknown precision '" << o.precision << "' (known: fp64, mixed)");
+                        "--precision: unknown precision '" << o.precision << "' (known: fp64, mixed, fp32)");
   settings.options.precision = *precision;
   KUSHNER_INPUT_REQUIRE(o.step_pairs == "auto" || o.step_pairs == "always" || o.step_pairs == "never",
                         "--step-pairs: unknown value '" << o.step_pairs << "' (known: auto, always, never)");

@@ -141,8 +141,7 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
       bank_filters.push_back(name);
     } else if (name == particle_filter_name) {
       if constexpr (particle_filter_unsupported<Model>() == nullptr)
-        outside.push_back(
-            std::make_unique<ParticleReference<ExecSpace, Model>>(space, filter_model, members, rank_seed, particle));
+        outside.push_back(make_particle_reference(space, filter_model, members, rank_seed, particle));
     } else if constexpr (has_exact_reference<Model>) {
       outside.push_back(std::make_unique<ExactReferenceEstimator<ExecSpace, Model>>(space, filter_model, members));
     }

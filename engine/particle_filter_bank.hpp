@@ -75,7 +75,9 @@ struct ParticleFilterOptions {
   ParticlePrecision precision = ParticlePrecision::fp64;
 };
 
-template <class ExecSpace, class Model>
+/// Real: how the particles and log-weights are stored, double, or float for the fp32 precision (the constructor
+/// requires options.precision to match; particle_reference.hpp picks the class).
+template <class ExecSpace, class Model, class Real = double>
 class ParticleFilterBank {
  public:
   using MemSpace = typename ExecSpace::memory_space;
@@ -105,8 +107,12 @@ class ParticleFilterBank {
            (bytes_per_particle(options) * static_cast<double>(particles) + bytes_per_member(particles));
   }
   static double bytes_per_particle(const ParticleFilterOptions& options) {
-    return 2.0 * sizeof(double) * state_dim + sizeof(double) + sizeof(int) +
+    return (2.0 * state_dim + 1.0) * stored_bytes(options) + sizeof(int) +
            (options.scheme == ResamplingScheme::residual ? sizeof(int) : 0);
+  }
+  /// Bytes of one stored particle coordinate or log-weight under `options`' precision.
+  static double stored_bytes(const ParticleFilterOptions& options) {
+    return options.precision == ParticlePrecision::fp32 ? sizeof(float) : sizeof(double);
   }
   static double bytes_per_member(long particles) {
     const double blocks = static_cast<double>((particles + host_particle_block - 1) / host_particle_block);
@@ -117,15 +123,17 @@ class ParticleFilterBank {
 
   /// Bytes step_pair allocates besides bytes_needed when it fuses its steps: a second bank of states and
   /// log-weights, the second step's block partials (at the host's block, an upper bound) and step k's posterior.
-  static double step_pair_bytes_needed(long members, long particles) {
+  static double step_pair_bytes_needed(long members, long particles, const ParticleFilterOptions& options) {
     const double blocks = static_cast<double>((particles + host_particle_block - 1) / host_particle_block);
     return static_cast<double>(members) *
-           (step_pair_bytes_per_particle() * static_cast<double>(particles) +
+           (step_pair_bytes_per_particle(options) * static_cast<double>(particles) +
             sizeof(double) * (blocks * WeightedMoments<state_dim>::size + 2.0 + state_dim + packed_size(state_dim)) +
             sizeof(Status));
   }
   /// The second bank's state and log-weight.
-  static double step_pair_bytes_per_particle() { return sizeof(double) * (state_dim + 1.0); }
+  static double step_pair_bytes_per_particle(const ParticleFilterOptions& options) {
+    return stored_bytes(options) * (state_dim + 1.0);
+  }
 
   /// Whether a bank with `options` and `particles` particles per member fuses step_pair's two steps (the team
   /// kernel with chunked systematic resampling).
@@ -175,8 +183,8 @@ class ParticleFilterBank {
   const BankScalar<Status, MemSpace>& status() const { return status_; }
   /// (particle, member, i) and (particle, member): the particles and their log-weights; the normalized weight
   /// of particle j is exp(log_weights(j, m) - log_normalizer(m)).
-  const ParticleBank<MemSpace>& particles() const { return x_; }
-  const Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace>& log_weights() const { return workspace_.cumulative; }
+  const ParticleBank<MemSpace, Real>& particles() const { return x_; }
+  const ParticleColumn<MemSpace, Real>& log_weights() const { return workspace_.cumulative; }
   const BankScalar<double, MemSpace>& log_normalizer() const { return log_normalizer_; }
 
   /// What a checkpoint holds: the particles, their log-weights and everything a step reads from the step
@@ -219,9 +227,9 @@ class ParticleFilterBank {
     return cholesky_inverse(root);
   }
 
-  ParticleStepData<Model, MemSpace> step_data(double t, double dt, std::uint32_t step,
-                                              const BankVector<MemSpace>& dy) const {
-    ParticleStepData<Model, MemSpace> d;
+  ParticleStepData<Model, MemSpace, Real> step_data(double t, double dt, std::uint32_t step,
+                                                    const BankVector<MemSpace>& dy) const {
+    ParticleStepData<Model, MemSpace, Real> d;
     d.model = model_;
     d.x = x_;
     d.log_weight = workspace_.cumulative;
@@ -240,14 +248,14 @@ class ParticleFilterBank {
     d.step = step;
     d.num_particles = num_particles_;
     d.block_size = block_size_;
-    d.fp32_normals = options_.precision == ParticlePrecision::mixed;
+    d.fp32_normals = options_.precision != ParticlePrecision::fp64;
     return d;
   }
 
-  void run_step_kernels(const ParticleStepData<Model, MemSpace>& d) {
+  void run_step_kernels(const ParticleStepData<Model, MemSpace, Real>& d) {
     constexpr int n = state_dim;
     if (use_team_) {
-      run_team_kernel(ParticleTeamStep<Model, ExecSpace>{d});
+      run_team_kernel(ParticleTeamStep<Model, ExecSpace, Real>{d});
     } else {
       run_host_block_kernel(d);
     }
@@ -264,16 +272,18 @@ class ParticleFilterBank {
       const int team = options_.team_size > 0 ? options_.team_size : device_resample_team;
       Kokkos::TeamPolicy<ExecSpace, Kokkos::LaunchBounds<device_resample_team, 1>> policy(space_, num_members_, team);
       policy.set_scratch_size(0, Kokkos::PerTeam(sizeof(double) * scan_num_blocks(num_particles_)));
-      Kokkos::parallel_for("kushner::particle_resample", policy,
-                           ParticleResampleStep<n, ExecSpace>{x_, x_scratch_, workspace_, log_normalizer_, resample_,
-                                                              num_particles_, options_.scheme, seed_, d.step});
+      Kokkos::parallel_for(
+          "kushner::particle_resample", policy,
+          ParticleResampleStep<n, ExecSpace, Real>{x_, x_scratch_, workspace_, log_normalizer_, resample_,
+                                                   num_particles_, options_.scheme, seed_, d.step});
       return;
     }
     Kokkos::TeamPolicy<ExecSpace> policy(space_, num_members_, team_size_);
     policy.set_scratch_size(0, Kokkos::PerTeam(sizeof(double) * scan_num_blocks(num_particles_)));
-    Kokkos::parallel_for("kushner::particle_resample", policy,
-                         ParticleResampleStep<n, ExecSpace>{x_, x_scratch_, workspace_, log_normalizer_, resample_,
-                                                            num_particles_, options_.scheme, seed_, d.step});
+    Kokkos::parallel_for(
+        "kushner::particle_resample", policy,
+        ParticleResampleStep<n, ExecSpace, Real>{x_, x_scratch_, workspace_, log_normalizer_, resample_, num_particles_,
+                                                 options_.scheme, seed_, d.step});
   }
 
   /// The posterior of a step from its block partials, into `out` and `log_normalizer`; resampling decisions
@@ -291,17 +301,17 @@ class ParticleFilterBank {
 
   /// Chunked systematic resampling of the listed members at `step`, from the log-weights less `log_normalizer`.
   void resample_listed(const BankScalar<double, MemSpace>& log_normalizer, std::uint32_t step) {
-    const ChunkedResampleData<MemSpace> r{x_,
-                                          x_scratch_,
-                                          workspace_.cumulative,
-                                          workspace_.ancestors,
-                                          block_sums_,
-                                          log_normalizer,
-                                          resample_list_,
-                                          resample_list_size_,
-                                          num_particles_,
-                                          seed_,
-                                          step};
+    const ChunkedResampleData<MemSpace, Real> r{x_,
+                                                x_scratch_,
+                                                workspace_.cumulative,
+                                                workspace_.ancestors,
+                                                block_sums_,
+                                                log_normalizer,
+                                                resample_list_,
+                                                resample_list_size_,
+                                                num_particles_,
+                                                seed_,
+                                                step};
     // A fixed league loops over (member, chunk) items: the number of members to resample stays on the device.
     const long items = static_cast<long>(num_members_) * resample_chunks(num_particles_);
     const int league = static_cast<int>(items < chunked_resample_league ? items : chunked_resample_league);
@@ -352,11 +362,11 @@ class ParticleFilterBank {
     Kokkos::parallel_for("kushner::particle_team_step", policy, launcher);
   }
 
-  void run_host_block_kernel(const ParticleStepData<Model, MemSpace>& d) {
+  void run_host_block_kernel(const ParticleStepData<Model, MemSpace, Real>& d) {
     if constexpr (std::is_same<MemSpace, Kokkos::HostSpace>::value) {
       Kokkos::parallel_for("kushner::particle_block_step",
                            Kokkos::RangePolicy<ExecSpace>(space_, 0, num_blocks_ * num_members_),
-                           ParticleBlockStep<Model>{d, num_blocks_});
+                           ParticleBlockStep<Model, Real>{d, num_blocks_});
     }
   }
 
@@ -367,11 +377,11 @@ class ParticleFilterBank {
   int num_members_, num_particles_;
   bool use_team_ = false;
   int block_size_ = 0, num_blocks_ = 0, team_size_ = 1;
-  ParticleBank<MemSpace> x_, x_scratch_;
-  ResamplingWorkspace<MemSpace> workspace_;
+  ParticleBank<MemSpace, Real> x_, x_scratch_;
+  ResamplingWorkspace<MemSpace, Real> workspace_;
   // step_pair: the second bank, the second step's partials, step k's posterior.
-  ParticleBank<MemSpace> x_next_;
-  Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> log_weight_next_;
+  ParticleBank<MemSpace, Real> x_next_;
+  ParticleColumn<MemSpace, Real> log_weight_next_;
   Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace> partials_next_;
   PosteriorViews first_;
   BankScalar<double, MemSpace> first_log_normalizer_;
@@ -387,10 +397,10 @@ class ParticleFilterBank {
   BankScalar<Status, MemSpace> status_;
 };
 
-template <class ExecSpace, class Model>
-ParticleFilterBank<ExecSpace, Model>::ParticleFilterBank(const ExecSpace& space, const Model& model, int num_members,
-                                                         int num_particles, Seed seed,
-                                                         const ParticleFilterOptions& options)
+template <class ExecSpace, class Model, class Real>
+ParticleFilterBank<ExecSpace, Model, Real>::ParticleFilterBank(const ExecSpace& space, const Model& model,
+                                                               int num_members, int num_particles, Seed seed,
+                                                               const ParticleFilterOptions& options)
     : space_(space),
       model_(model),
       options_(options),
@@ -401,6 +411,11 @@ ParticleFilterBank<ExecSpace, Model>::ParticleFilterBank(const ExecSpace& space,
   KUSHNER_REQUIRE(num_particles >= 1, "particles: " << num_particles);
   KUSHNER_REQUIRE(options.ess_threshold >= 0.0 && options.ess_threshold <= 1.0,
                   "ess_threshold: " << options.ess_threshold);
+  static_assert(std::is_same_v<Real, double> || std::is_same_v<Real, float>);
+  constexpr bool stores_float = std::is_same_v<Real, float>;
+  KUSHNER_REQUIRE((options.precision == ParticlePrecision::fp32) == stores_float,
+                  "ParticleFilterBank: precision " << to_string(options.precision) << " stored as "
+                                                   << (stores_float ? "float" : "double"));
   use_team_ = uses_team_kernel(options);
   constexpr bool host_memory = std::is_same<MemSpace, Kokkos::HostSpace>::value;
   KUSHNER_REQUIRE(use_team_ || host_memory, "the host block kernel needs host memory");
@@ -413,8 +428,8 @@ ParticleFilterBank<ExecSpace, Model>::ParticleFilterBank(const ExecSpace& space,
                   "particle blocks must hold whole pairs of particles (block of " << block_size_ << ")");
 
   const int n = state_dim;
-  x_ = ParticleBank<MemSpace>("kushner::particles", num_particles, num_members, n);
-  x_scratch_ = ParticleBank<MemSpace>("kushner::particles_scratch", num_particles, num_members, n);
+  x_ = ParticleBank<MemSpace, Real>("kushner::particles", num_particles, num_members, n);
+  x_scratch_ = ParticleBank<MemSpace, Real>("kushner::particles_scratch", num_particles, num_members, n);
   workspace_.cumulative = decltype(workspace_.cumulative)("kushner::log_weights", num_particles, num_members);
   workspace_.ancestors = decltype(workspace_.ancestors)("kushner::ancestors", num_particles, num_members);
   use_chunked_resample_ = fuses_step_pairs(options, num_particles);
@@ -441,29 +456,29 @@ ParticleFilterBank<ExecSpace, Model>::ParticleFilterBank(const ExecSpace& space,
   auto reference = Kokkos::create_mirror_view(reference_);  // moments are taken relative to the initial mean
   for (int m = 0; m < num_members; ++m) store(reference, m, initial_mean);
   Kokkos::deep_copy(space_, reference_, reference);
-  ParticleStepData<Model, MemSpace> d = step_data(0.0, 0.0, 0, BankVector<MemSpace>());
+  ParticleStepData<Model, MemSpace, Real> d = step_data(0.0, 0.0, 0, BankVector<MemSpace>());
   d.initialize = true;
   d.initial_mean = initial_mean;
   d.initial_root = initial_root;
   run_step_kernels(d);
 }
 
-template <class ExecSpace, class Model>
-void ParticleFilterBank<ExecSpace, Model>::step(long k, double dt, const BankVector<MemSpace>& dy,
-                                                const BankVector<MemSpace>& control) {
+template <class ExecSpace, class Model, class Real>
+void ParticleFilterBank<ExecSpace, Model, Real>::step(long k, double dt, const BankVector<MemSpace>& dy,
+                                                      const BankVector<MemSpace>& control) {
   require_increments_shape(dy);
   KUSHNER_REQUIRE(k >= 0 && k < (1L << 32), "step " << k << " outside the counter range");
   KUSHNER_REQUIRE(
       control.extent(0) == 0 || (control.extent_int(0) == num_members_ && control.extent_int(1) == Model::control_dim),
       "control bank has shape (" << control.extent(0) << ", " << control.extent(1) << ")");
-  ParticleStepData<Model, MemSpace> d = step_data(k * dt, dt, static_cast<std::uint32_t>(k), dy);
+  ParticleStepData<Model, MemSpace, Real> d = step_data(k * dt, dt, static_cast<std::uint32_t>(k), dy);
   d.control = control;
   run_step_kernels(d);
 }
 
-template <class ExecSpace, class Model>
-void ParticleFilterBank<ExecSpace, Model>::step_pair(long k, double dt, const BankVector<MemSpace>& dy,
-                                                     const BankVector<MemSpace>& dy_next) {
+template <class ExecSpace, class Model, class Real>
+void ParticleFilterBank<ExecSpace, Model, Real>::step_pair(long k, double dt, const BankVector<MemSpace>& dy,
+                                                           const BankVector<MemSpace>& dy_next) {
   KUSHNER_REQUIRE(k >= 0 && k + 1 < (1L << 32), "steps " << k << ", " << k + 1 << " outside the counter range");
   allocate_first_step();
   if (!use_chunked_resample_) {
@@ -478,15 +493,15 @@ void ParticleFilterBank<ExecSpace, Model>::step_pair(long k, double dt, const Ba
   require_increments_shape(dy);
   require_increments_shape(dy_next);
   if (x_next_.extent(0) == 0) {
-    x_next_ = ParticleBank<MemSpace>("kushner::particles_next", num_particles_, num_members_, state_dim);
+    x_next_ = ParticleBank<MemSpace, Real>("kushner::particles_next", num_particles_, num_members_, state_dim);
     log_weight_next_ = decltype(log_weight_next_)("kushner::log_weights_next", num_particles_, num_members_);
     partials_next_ = decltype(partials_next_)("kushner::particle_partials_next", num_blocks_, num_members_,
                                               WeightedMoments<state_dim>::size);
   }
   const auto first = static_cast<std::uint32_t>(k), second = first + 1;
-  const ParticleSecondStep<Model, MemSpace> next{
+  const ParticleSecondStep<Model, MemSpace, Real> next{
       x_next_, log_weight_next_, dy_next, partials_next_, observation_precision((k + 1) * dt), (k + 1) * dt};
-  run_team_kernel(ParticleTeamPairStep<Model, ExecSpace>{step_data(k * dt, dt, first, dy), next});
+  run_team_kernel(ParticleTeamPairStep<Model, ExecSpace, Real>{step_data(k * dt, dt, first, dy), next});
   // The pass's output becomes the bank; its input (step k - 1's particles) stays for the redo.
   std::swap(x_, x_next_);
   std::swap(workspace_.cumulative, log_weight_next_);
@@ -498,23 +513,23 @@ void ParticleFilterBank<ExecSpace, Model>::step_pair(long k, double dt, const Ba
   // The members step k resamples: copy their step k - 1 particles back, step k, resample, step k + 1.
   const long copy_items = static_cast<long>(num_members_) * num_particles_;
   copy_listed_members<state_dim>(
-      space_, CopyListedMembers<state_dim, MemSpace>{x_next_, x_, log_weight_next_, workspace_.cumulative,
-                                                     resample_list_, resample_list_size_, num_particles_,
-                                                     copy_items < listed_copy_items ? copy_items : listed_copy_items});
-  run_team_kernel_listed(ParticleTeamStep<Model, ExecSpace>{step_data(k * dt, dt, first, dy)});
+      space_, CopyListedMembers<state_dim, MemSpace, Real>{
+                  x_next_, x_, log_weight_next_, workspace_.cumulative, resample_list_, resample_list_size_,
+                  num_particles_, copy_items < listed_copy_items ? copy_items : listed_copy_items});
+  run_team_kernel_listed(ParticleTeamStep<Model, ExecSpace, Real>{step_data(k * dt, dt, first, dy)});
   resample_listed(first_log_normalizer_, first);
-  ParticleStepData<Model, MemSpace> redo = step_data((k + 1) * dt, dt, second, dy_next);
+  ParticleStepData<Model, MemSpace, Real> redo = step_data((k + 1) * dt, dt, second, dy_next);
   redo.log_normalizer = first_log_normalizer_;  // log N after the resampling
   redo.partials = partials_next_;
-  run_team_kernel_listed(ParticleTeamStep<Model, ExecSpace>{redo});
+  run_team_kernel_listed(ParticleTeamStep<Model, ExecSpace, Real>{redo});
   // Step k + 1's posterior and resampling, as in step().
   Kokkos::deep_copy(space_, resample_list_size_, 0);
   run_posterior(partials_next_, current_posterior(), log_normalizer_, true);
   resample_listed(log_normalizer_, second);
 }
 
-template <class ExecSpace, class Model>
-auto ParticleFilterBank<ExecSpace, Model>::monte_carlo_standard_error() const -> BankVector<MemSpace> {
+template <class ExecSpace, class Model, class Real>
+auto ParticleFilterBank<ExecSpace, Model, Real>::monte_carlo_standard_error() const -> BankVector<MemSpace> {
   BankVector<MemSpace> se("kushner::particle_mc_se", num_members_, state_dim);
   parallel_for_members("kushner::particle_mc_se", space_, num_members_,
                        MonteCarloStandardError<state_dim, MemSpace>{covariance_, ess_, se});
@@ -525,11 +540,12 @@ auto ParticleFilterBank<ExecSpace, Model>::monte_carlo_standard_error() const ->
 /// engine/shared_instances.hpp): Model, or NotShared<Model> above the particle filter's largest dimension.
 template <class Model>
 using ParticleInstanceModel = SharedModel<Model, particle_filter_unsupported<Model>() == nullptr>;
-template <class ExecSpace, class Model>
-class ParticleFilterBank<ExecSpace, NotShared<Model>> {};
+template <class ExecSpace, class Model, class Real>
+class ParticleFilterBank<ExecSpace, NotShared<Model>, Real> {};
 
-#define KUSHNER_SHARED_INSTANCE(Space, Model) \
-  extern template class ParticleFilterBank<Space, ParticleInstanceModel<Model>>;
+#define KUSHNER_SHARED_INSTANCE(Space, Model)                                    \
+  extern template class ParticleFilterBank<Space, ParticleInstanceModel<Model>>; \
+  extern template class ParticleFilterBank<Space, ParticleInstanceModel<Model>, float>;
 KUSHNER_FOR_EACH_SHARED_INSTANCE
 #undef KUSHNER_SHARED_INSTANCE
 

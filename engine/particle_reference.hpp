@@ -14,6 +14,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace kushner {
@@ -49,7 +50,9 @@ struct AccumulateEss {
   }
 };
 
-template <class ExecSpace, class Model>
+/// Real: the particle filter's storage (ParticleFilterBank), float for the fp32 precision: make_particle_reference
+/// picks it from the settings.
+template <class ExecSpace, class Model, class Real = double>
 class ParticleReference final : public ReferenceEstimator<typename ExecSpace::memory_space> {
  public:
   using MemSpace = typename ExecSpace::memory_space;
@@ -79,7 +82,7 @@ class ParticleReference final : public ReferenceEstimator<typename ExecSpace::me
 
   void visit_state(StateArchive& archive) override;
 
-  const ParticleFilterBank<ExecSpace, Model>& bank() const { return pf_; }
+  const ParticleFilterBank<ExecSpace, Model, Real>& bank() const { return pf_; }
 
  private:
   void accumulate_ess(const BankScalar<double, MemSpace>& ess, const BankSymmetric<MemSpace>& covariance) {
@@ -89,28 +92,28 @@ class ParticleReference final : public ReferenceEstimator<typename ExecSpace::me
   }
 
   ExecSpace space_;
-  ParticleFilterBank<ExecSpace, Model> pf_;
+  ParticleFilterBank<ExecSpace, Model, Real> pf_;
   BankVector<MemSpace> sums_;
   bool in_pairs_;
   long steps_ = 0;
 };
 
-template <class ExecSpace, class Model>
-void ParticleReference<ExecSpace, Model>::advance(long k, double, double dt, const BankVector<MemSpace>& dy) {
+template <class ExecSpace, class Model, class Real>
+void ParticleReference<ExecSpace, Model, Real>::advance(long k, double, double dt, const BankVector<MemSpace>& dy) {
   pf_.step(k, dt, dy);
   accumulate_ess(pf_.effective_sample_size(), pf_.posterior_covariance());
 }
 
-template <class ExecSpace, class Model>
-void ParticleReference<ExecSpace, Model>::advance_pair(long k, double, double dt, const BankVector<MemSpace>& dy,
-                                                       const BankVector<MemSpace>& dy_next) {
+template <class ExecSpace, class Model, class Real>
+void ParticleReference<ExecSpace, Model, Real>::advance_pair(long k, double, double dt, const BankVector<MemSpace>& dy,
+                                                             const BankVector<MemSpace>& dy_next) {
   pf_.step_pair(k, dt, dy, dy_next);
   accumulate_ess(pf_.first_step().ess, pf_.first_step().covariance);
   accumulate_ess(pf_.effective_sample_size(), pf_.posterior_covariance());
 }
 
-template <class ExecSpace, class Model>
-Fields ParticleReference<ExecSpace, Model>::describe() const {
+template <class ExecSpace, class Model, class Real>
+Fields ParticleReference<ExecSpace, Model, Real>::describe() const {
   space_.fence();
   const auto sums = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sums_);
   const auto resamples = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pf_.resample_count());
@@ -141,25 +144,35 @@ Fields ParticleReference<ExecSpace, Model>::describe() const {
           {"resamples_per_member_step", steps_ > 0 ? resample_total / member_steps : std::nan("")}};
 }
 
-template <class ExecSpace, class Model>
-std::optional<ParticleSnapshot> ParticleReference<ExecSpace, Model>::particle_snapshot(
+template <class ExecSpace, class Model, class Real>
+std::optional<ParticleSnapshot> ParticleReference<ExecSpace, Model, Real>::particle_snapshot(
     const std::vector<int>& members) const {
   return ParticleSnapshot(pf_, members);
 }
 
-template <class ExecSpace, class Model>
-void ParticleReference<ExecSpace, Model>::visit_state(StateArchive& archive) {
+template <class ExecSpace, class Model, class Real>
+void ParticleReference<ExecSpace, Model, Real>::visit_state(StateArchive& archive) {
   pf_.visit_state(archive);
   archive.view("ess_sums", sums_);
   archive.value("steps", steps_);
 }
 
 /// A model the particle filter does not run has no shared ParticleReference (ParticleInstanceModel).
-template <class ExecSpace, class Model>
-class ParticleReference<ExecSpace, NotShared<Model>> {};
+template <class ExecSpace, class Model, class Real>
+class ParticleReference<ExecSpace, NotShared<Model>, Real> {};
 
-#define KUSHNER_SHARED_INSTANCE(Space, Model) \
-  extern template class ParticleReference<Space, ParticleInstanceModel<Model>>;
+/// The particle filter of `settings` as a reference estimator, stored in float for the fp32 precision.
+template <class ExecSpace, class Model>
+std::unique_ptr<ReferenceEstimator<typename ExecSpace::memory_space>> make_particle_reference(
+    const ExecSpace& space, const Model& model, long members, Seed seed, const ParticleSettings& settings) {
+  if (settings.options.precision == ParticlePrecision::fp32)
+    return std::make_unique<ParticleReference<ExecSpace, Model, float>>(space, model, members, seed, settings);
+  return std::make_unique<ParticleReference<ExecSpace, Model>>(space, model, members, seed, settings);
+}
+
+#define KUSHNER_SHARED_INSTANCE(Space, Model)                                   \
+  extern template class ParticleReference<Space, ParticleInstanceModel<Model>>; \
+  extern template class ParticleReference<Space, ParticleInstanceModel<Model>, float>;
 KUSHNER_FOR_EACH_SHARED_INSTANCE
 #undef KUSHNER_SHARED_INSTANCE
 

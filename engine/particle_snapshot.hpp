@@ -42,25 +42,29 @@ inline double bimodality_score(const std::vector<double>& histogram) {
 
 class ParticleSnapshot {
  public:
-  template <class ExecSpace, class Model>
-  explicit ParticleSnapshot(const ParticleFilterBank<ExecSpace, Model>& pf)
+  template <class ExecSpace, class Model, class Real>
+  explicit ParticleSnapshot(const ParticleFilterBank<ExecSpace, Model, Real>& pf)
       : members_(pf.num_members()),
         particles_(pf.num_particles()),
         dim_(Model::state_dim),
-        x_(Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pf.particles())),
+        x_("kushner::snapshot_particles", particles_, members_, dim_),
         w_("kushner::snapshot_weights", particles_, members_) {
+    const auto x = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pf.particles());
     const auto lw = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pf.log_weights());
     const auto ln = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pf.log_normalizer());
     for (int m = 0; m < members_; ++m)
-      for (int j = 0; j < particles_; ++j) w_(j, m) = std::exp(lw(j, m) - ln(m));
+      for (int j = 0; j < particles_; ++j) {
+        w_(j, m) = std::exp(lw(j, m) - ln(m));
+        for (int i = 0; i < dim_; ++i) x_(j, m, i) = x(j, m, i);
+      }
     column_.resize(members_);
     std::iota(column_.begin(), column_.end(), 0);
   }
 
   /// Only the members in `members` (each in range): what a run that follows a few members needs, without
   /// copying the whole bank.
-  template <class ExecSpace, class Model>
-  ParticleSnapshot(const ParticleFilterBank<ExecSpace, Model>& pf, const std::vector<int>& members)
+  template <class ExecSpace, class Model, class Real>
+  ParticleSnapshot(const ParticleFilterBank<ExecSpace, Model, Real>& pf, const std::vector<int>& members)
       : members_(pf.num_members()),
         particles_(pf.num_particles()),
         dim_(Model::state_dim),

@@ -22,9 +22,14 @@ using BankSymmetric = Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace>;
 template <class MemSpace>
 using BankMatrix = Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace>;
 
-/// (particle, member, i): particle states, particle index contiguous within a member.
-template <class MemSpace>
-using ParticleBank = Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace>;
+/// (particle, member, i): particle states, particle index contiguous within a member; stored as Real (float in the
+/// particle filter's fp32 precision).
+template <class MemSpace, class Real = double>
+using ParticleBank = Kokkos::View<Real***, Kokkos::LayoutLeft, MemSpace>;
+
+/// (particle, member): one number per particle (log-weights), stored as Real.
+template <class MemSpace, class Real = double>
+using ParticleColumn = Kokkos::View<Real**, Kokkos::LayoutLeft, MemSpace>;
 
 /// (member): one scalar per member (status, counts, log-normalizers).
 template <class T, class MemSpace>

@@ -1,8 +1,8 @@
 // The whole particle-filter step (propagate, weight, block moments, posterior and ESS, amortized
-// resampling) in particle-steps per second, sine model, fp64 or mixed precision, next to BM_StreamCopy of the bytes a
-// step must move (the memory floor) in the same binary. Observation increments come from a bank of truths that is
-// stepped outside the timed region. With steps = 2 each timed call is ParticleFilterBank::step_pair (two steps, one
-// pass over the particles on a GPU: half the bytes per particle-step).
+// resampling) in particle-steps per second, sine model, fp64, mixed or fp32 precision, next to BM_StreamCopy of the
+// bytes an fp64 step must move (the memory floor) in the same binary. Observation increments come from a bank of truths
+// that is stepped outside the timed region. With steps = 2 each timed call is ParticleFilterBank::step_pair (two steps,
+// one pass over the particles on a GPU: half the bytes per particle-step).
 #include "engine/particle_filter_bank.hpp"
 #include "engine/truth_bank.hpp"
 #include "models/sine_model.hpp"
@@ -14,27 +14,24 @@
 namespace kushner {
 namespace {
 
-/// Bytes a step must move per particle: read and write the state (state_dim doubles) and the log-weight.
+/// Bytes a step must move per particle: read and write the state (state_dim numbers) and the log-weight, each
+/// `stored` bytes (8 in fp64 and mixed, 4 in fp32).
 template <class Model>
-constexpr double bytes_per_particle_step() {
-  return 8.0 * 2 * (Model::state_dim + 1);
+constexpr double bytes_per_particle_step(double stored = 8.0) {
+  return stored * 2 * (Model::state_dim + 1);
 }
 
 constexpr double dt = 1e-3;
 constexpr int warmup_steps = 200;  // past the first resamplings, which the prior's spread makes frequent
 
-template <class Model>
-void BM_ParticleFilterStep(benchmark::State& state) {
+template <class Model, class Real>
+void particle_filter_steps(benchmark::State& state, const ParticleFilterOptions& options) {
   using Space = Kokkos::DefaultExecutionSpace;
   const int members = static_cast<int>(state.range(0)), particles = static_cast<int>(state.range(1));
   const Space space;
   const Model model;
   TruthBank<Space, Model> truth(space, model, members, 42);
-  ParticleFilterOptions options;
-  if (state.range(3) == 0) options.ess_threshold = 0.0;  // never resample: the cost of the other kernels
-  if (state.range(2) > 0) options.particles_per_thread = static_cast<int>(state.range(2));
-  if (state.range(5) == 1) options.precision = ParticlePrecision::mixed;
-  ParticleFilterBank<Space, Model> pf(space, model, members, particles, 43, options);
+  ParticleFilterBank<Space, Model, Real> pf(space, model, members, particles, 43, options);
   const bool pairs = state.range(4) == 2;
   BankVector<typename Space::memory_space> first_dy("first_dy", members, Model::obs_dim);
   long k = 0;
@@ -62,7 +59,7 @@ void BM_ParticleFilterStep(benchmark::State& state) {
   const double particle_steps = static_cast<double>(members) * particles * (pairs ? 2 : 1);
   state.counters["particle_steps_per_s"] = C(particle_steps, C::kIsIterationInvariantRate);
   // A fused pair reads and writes the particles once for two steps.
-  const double bytes = bytes_per_particle_step<Model>() / (pairs && pf.fuses_step_pairs() ? 2 : 1);
+  const double bytes = bytes_per_particle_step<Model>(sizeof(Real)) / (pairs && pf.fuses_step_pairs() ? 2 : 1);
   state.counters["GB_per_s"] = C(1e-9 * bytes * particle_steps, C::kIsIterationInvariantRate);
   state.counters["bytes_per_particle_step"] = bytes;
   const auto counts = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), pf.resample_count());
@@ -77,6 +74,19 @@ void BM_ParticleFilterStep(benchmark::State& state) {
     }
   }
   state.counters["resamples_per_member_step"] = resamples / (static_cast<double>(members) * k);
+}
+
+template <class Model>
+void BM_ParticleFilterStep(benchmark::State& state) {
+  ParticleFilterOptions options;
+  if (state.range(3) == 0) options.ess_threshold = 0.0;  // never resample: the cost of the other kernels
+  if (state.range(2) > 0) options.particles_per_thread = static_cast<int>(state.range(2));
+  if (state.range(5) == 1) options.precision = ParticlePrecision::mixed;
+  if (state.range(5) == 2) options.precision = ParticlePrecision::fp32;
+  if (options.precision == ParticlePrecision::fp32)
+    particle_filter_steps<Model, float>(state, options);
+  else
+    particle_filter_steps<Model, double>(state, options);
 }
 
 /// The physical floor: a deep_copy of the bytes one step moves (half read, half written).
@@ -103,19 +113,21 @@ void BM_StreamCopy(benchmark::State& state) {
 // M x N: the CPU target (100 x 4096), then M.N = 1e6 .. 1e9; sizes past 1e7 only where a GPU runs them.
 // The third argument (GPU team kernel only) is particles per thread, 0 = the default; the fourth, 0, turns
 // resampling off (ESS threshold 0), which shows what resampling costs; the fifth is steps per timed call
-// (2: step_pair, which fuses them where the team kernel runs); the sixth, 1, draws the normals in fp32 (the
-// `mixed` precision).
+// (2: step_pair, which fuses them where the team kernel runs); the sixth is the precision: 0 fp64, 1 mixed (normals
+// drawn in fp32), 2 fp32 (also particles and log-weights stored in float).
 BENCHMARK_TEMPLATE(BM_ParticleFilterStep, SineModel)
     ->Apply([](benchmark::internal::Benchmark* b) {
-      b->ArgNames({"members", "particles", "per_thread", "resample", "steps", "mixed"});
+      b->ArgNames({"members", "particles", "per_thread", "resample", "steps", "precision"});
       b->Args({100, 4096, 0, 1, 1, 0})->Args({1000, 1024, 0, 1, 1, 0})->Args({1000, 16384, 0, 1, 1, 0});
       b->Args({100, 4096, 0, 1, 1, 1})->Args({1000, 16384, 0, 1, 1, 1});
+      b->Args({100, 4096, 0, 1, 1, 2})->Args({1000, 16384, 0, 1, 1, 2});
 #if defined(KOKKOS_ENABLE_CUDA)
       b->Args({1000, 65536, 0, 1, 1, 0})->Args({10000, 65536, 0, 1, 1, 0})->Args({15259, 65536, 0, 1, 1, 0});
       b->Args({1000, 65536, 8, 1, 1, 0})->Args({1000, 65536, 32, 1, 1, 0})->Args({1000, 65536, 0, 0, 1, 0});
       b->Args({1000, 65536, 0, 1, 2, 0})->Args({1000, 65536, 0, 0, 2, 0})->Args({1000, 1024, 0, 1, 2, 0});
       b->Args({1000, 16384, 0, 1, 2, 0})->Args({10000, 65536, 0, 1, 2, 0});
       b->Args({1000, 65536, 0, 1, 1, 1})->Args({1000, 65536, 0, 1, 2, 1})->Args({10000, 65536, 0, 1, 2, 1});
+      b->Args({1000, 65536, 0, 1, 1, 2})->Args({1000, 65536, 0, 1, 2, 2})->Args({10000, 65536, 0, 1, 2, 2});
 #endif
     })
     ->UseManualTime();

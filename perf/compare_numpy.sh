@@ -15,7 +15,7 @@ python=python3
 "$python" -c "import numpy" 2>/dev/null || python=/usr/bin/python3  # Debian's python3-numpy
 reps=${KUSHNER_REPETITIONS:-10}
 export OMP_PROC_BIND=${OMP_PROC_BIND:-false}
-"$build/perf/bench_particle_filter" --benchmark_filter='members:100/particles:4096/(per_thread:0/resample:1/steps:1/mixed:0/)?manual' \
+"$build/perf/bench_particle_filter" --benchmark_filter='members:100/particles:4096/(per_thread:0/resample:1/steps:1/precision:0/)?manual' \
   --benchmark_repetitions="$reps" --benchmark_enable_random_interleaving=true \
   --benchmark_out="$build/pf_cpu.json" --benchmark_out_format=json >/dev/null
 numpy_json=$("$python" "$here/perf/pf_numpy.py" --members 100 --particles 4096 --repetitions "$reps")

@@ -2,7 +2,8 @@
 # The particle filter on the GPU machine: builds the CUDA configuration, runs the particle-filter tests
 # (device vs host to 1e-12, systematic indices on every backend, the statistical references) and the
 # benchmarks, with the PyTorch version (perf/pf_torch.py, eager and torch.compile) and the JAX one (perf/pf_jax.py,
-# fp64 and fp32) timed in the same run, and `kushner filter --filters PF` through the command line (fp64, mixed).
+# fp64 and fp32) timed in the same run, and `kushner filter --filters PF` through the command line (fp64, mixed,
+# fp32).
 # Needs: the repository with .deps (Kokkos source, googletest, benchmark, header-only libraries), CUDA,
 # CMake, Python with PyTorch. No network.
 #   OUT=<dir> perf/run_gpu_benchmarks.sh        (results in $OUT; default ./gpu-out)
@@ -10,9 +11,9 @@
 # KUSHNER_REPETITIONS (10), KUSHNER_PHASES (default "build test compare sizes"):
 #   build    configure and build build-cuda/ (kept between calls on the device machine)
 #   test     the particle-filter test binaries (device vs host, systematic indices, statistical references)
-#   compare  M = 1000, N = 65536: kushner's PF step (fp64 and mixed, step and step_pair) and BM_StreamCopy (with
-#            power draw and SM clock sampled), then PyTorch eager and torch.compile, JAX fp64 and fp32, and the
-#            command line `kushner filter --model sine --filters PF` (fp64, mixed; each with --step-pairs auto
+#   compare  M = 1000, N = 65536: kushner's PF step (fp64, mixed and fp32, step and step_pair) and BM_StreamCopy
+#            (with power draw and SM clock sampled), then PyTorch eager and torch.compile, JAX fp64 and fp32, and the
+#            command line `kushner filter --model sine --filters PF` (fp64, mixed, fp32; each with --step-pairs auto
 #            and never; summary.json's step-loop rate), in the same call (the side-by-side ratios)
 #   sizes    every size M.N = 4e5 .. 1e9 (5 repetitions) and Kokkos vs Thrust resampling
 #   profile  Nsight Compute (ncu, where installed) on one launch of each step kernel at M = 1000, N = 65536:
@@ -86,7 +87,7 @@ if want compare; then
   # The command line: 1000 steps (dt 1e-3), the default 200 output points, no progress bar; summary.json's
   # timing.particle_steps_per_s is the step loop's rate (start-up and writing excluded).
   # Each precision with step pairs (the default: the fused pass, the bank scoring one step behind) and without.
-  for precision in fp64 mixed; do
+  for precision in fp64 mixed fp32; do
     for pairs in auto never; do
       name=cli_$precision; [ "$pairs" = auto ] || name=cli_${precision}_single
       rm -rf "$out/$name"

@@ -1,9 +1,9 @@
 // The particle filter against exact references: its posterior mean's RMS distance to the exact posterior
 // mean shrinks like N^{-1/2} (fitted slope in [-0.6, -0.4] over N = 2^8 .. 2^16) and, at N = 2^16, its bias
 // is within 4 Monte Carlo standard errors of zero -- for the linear model (1-D and 2-D, against the Kalman
-// filter of the same discretization) and the Benes model (against the closed form), in both precisions (fp64,
-// and mixed: normals drawn in fp32). Power: the same runs must reject a reference that is slightly wrong (a
-// drift offset, a shifted prior).
+// filter of the same discretization) and the Benes model (against the closed form), in every precision (fp64;
+// mixed: normals drawn in fp32; fp32: also the particles and log-weights stored in float). Power: the same runs must
+// reject a reference that is slightly wrong (a drift offset, a shifted prior).
 #include "engine/particle_filter_bank.hpp"
 #include "kernels/reference/benes_filter.hpp"
 #include "kernels/reference/kalman_bucy_reference.hpp"
@@ -43,8 +43,13 @@ Convergence converge(const Model& model, ParticlePrecision precision, const std:
   std::vector<double> wrong_rms;
   test::Trajectory largest;
   for (double n : particle_counts) {
-    ParticleFilterBank<Space, Model> pf(Space(), model, members, static_cast<int>(n), 4321, options);
-    largest = test::replay(pf, dys, dt);
+    if (precision == ParticlePrecision::fp32) {
+      ParticleFilterBank<Space, Model, float> pf(Space(), model, members, static_cast<int>(n), 4321, options);
+      largest = test::replay(pf, dys, dt);
+    } else {
+      ParticleFilterBank<Space, Model> pf(Space(), model, members, static_cast<int>(n), 4321, options);
+      largest = test::replay(pf, dys, dt);
+    }
     c.rms.push_back(test::rms_distance(largest, exact));
     wrong_rms.push_back(test::rms_distance(largest, wrong));
   }
@@ -121,6 +126,15 @@ TEST(MixedPrecisionParticleFilterAgainstKalman, LinearTwoDimensionalConvergesAtR
 TEST(MixedPrecisionParticleFilterAgainstBenes, ClosedFormConvergesAtRootNWithoutBias) {
   benes_case(ParticlePrecision::mixed);
 }
+
+// The fp32 precision (particles and log-weights stored in float): the same test on the same observations.
+TEST(Fp32ParticleFilterAgainstKalman, LinearOneDimensionalConvergesAtRootNWithoutBias) {
+  linear_model_case<1>(ParticlePrecision::fp32);
+}
+TEST(Fp32ParticleFilterAgainstKalman, LinearTwoDimensionalConvergesAtRootNWithoutBias) {
+  linear_model_case<2>(ParticlePrecision::fp32);
+}
+TEST(Fp32ParticleFilterAgainstBenes, ClosedFormConvergesAtRootNWithoutBias) { benes_case(ParticlePrecision::fp32); }
 
 TEST(KalmanBucyReference, ConvergesToTheStationaryRiccatiSolutionAsDtShrinks) {
   // 1-D: dP/dt = 2 a P + b^2 - P^2 / r^2 has the positive root P = r^2 (a + sqrt(a^2 + b^2 / r^2)). The

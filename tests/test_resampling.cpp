@@ -171,9 +171,9 @@ TYPED_TEST(SystematicOnEveryBackend, IndicesIdenticalToHostSerialAndAcrossTeamSi
 }
 
 /// w(j, m) = exp(l(j, m) - log_normalizer(m)): the weights the one-team path starts from.
-template <class Mem>
+template <class Mem, class Real = double>
 struct ExponentiatedWeights {
-  Kokkos::View<double**, Kokkos::LayoutLeft, Mem> l, w;
+  ParticleColumn<Mem, Real> l, w;
   BankScalar<double, Mem> log_normalizer;
   KOKKOS_INLINE_FUNCTION void operator()(const int j, const int m) const {
     w(j, m) = math::exp(l(j, m) - log_normalizer(m));
@@ -186,14 +186,14 @@ TYPED_TEST_SUITE(ChunkedSystematic, test::ExecutionSpaces);
 
 /// Resamples the `listed` members of a bank of n particles by the chunked path and by the one-team path on
 /// the same backend: the same ancestors, the particles moved accordingly, and only the listed members changed.
-/// Log-weights with rounding everywhere and dead particles.
-template <class Space>
+/// Log-weights with rounding everywhere and dead particles; stored as Real (float: the fp32 precision).
+template <class Space, class Real = double>
 void check_chunked_against_team_path(int n, int members, const std::vector<int>& listed) {
   using Mem = typename Space::memory_space;
   const std::uint32_t step = 17;
-  ChunkedResampleData<Mem> d;
-  d.x = ParticleBank<Mem>("x", n, members, 2);
-  d.x_scratch = ParticleBank<Mem>("x_scratch", n, members, 2);
+  ChunkedResampleData<Mem, Real> d;
+  d.x = ParticleBank<Mem, Real>("x", n, members, 2);
+  d.x_scratch = ParticleBank<Mem, Real>("x_scratch", n, members, 2);
   d.log_weight = decltype(d.log_weight)("l", n, members);
   d.ancestors = decltype(d.ancestors)("a", n, members);
   d.block_sums = decltype(d.block_sums)("block_sums", scan_num_blocks(n), members);
@@ -224,11 +224,11 @@ void check_chunked_against_team_path(int n, int members, const std::vector<int>&
   Kokkos::deep_copy(d.member_count, static_cast<int>(listed.size()));
 
   // The one-team path on the same backend: weights exp(l - log_normalizer), then resample_members.
-  ResamplingWorkspace<Mem> ws;
+  ResamplingWorkspace<Mem, Real> ws;
   ws.cumulative = decltype(ws.cumulative)("w", n, members);
   ws.ancestors = decltype(ws.ancestors)("a_team", n, members);
   Kokkos::parallel_for(Kokkos::MDRangePolicy<Space, Kokkos::Rank<2>>({0, 0}, {n, members}),
-                       ExponentiatedWeights<Mem>{d.log_weight, ws.cumulative, d.log_normalizer});
+                       ExponentiatedWeights<Mem, Real>{d.log_weight, ws.cumulative, d.log_normalizer});
   resample_members(Space(), ws, ResamplingScheme::systematic, seed, step);
 
   const bool host = std::is_same<Mem, Kokkos::HostSpace>::value;
@@ -262,6 +262,11 @@ TYPED_TEST(ChunkedSystematic, MatchesTheTeamPathAndMovesTheParticles) {
   // Over 2^20 particles: scan blocks of 269, which do not divide the chunk size.
   ASSERT_EQ(scan_block_size(1100003), 269);
   check_chunked_against_team_path<TypeParam>(1100003, 2, {1});
+}
+
+TYPED_TEST(ChunkedSystematic, MatchesTheTeamPathInFloatStorage) {
+  // The fp32 precision: weights and cumulative weights stored in float, summed in double by both paths.
+  check_chunked_against_team_path<TypeParam, float>(5003, 6, {3, 0, 5, 2});
 }
 
 }  // namespace

@@ -8,6 +8,8 @@
 
 #include <Kokkos_Core.hpp>
 
+#include <type_traits>
+
 namespace kushner {
 
 /// At most this many blocks per column: their sums live in team scratch memory (32 KiB of doubles).
@@ -22,22 +24,24 @@ KOKKOS_INLINE_FUNCTION constexpr int scan_num_blocks(int n) {
   return (n + scan_block_size(n) - 1) / scan_block_size(n);
 }
 
-/// values(0 .. n-1, member) <- inclusive prefix sums, in place; returns the total on every thread of the
-/// team. `block_sums` is team scratch with at least scan_num_blocks(n) entries. Integer columns are exact.
+/// values(0 .. n-1, member) <- inclusive prefix sums, in place; returns the total (as stored) on every thread of
+/// the team. `block_sums` is team scratch with at least scan_num_blocks(n) entries. Integer columns are exact; a
+/// float column is summed in double and each prefix rounded once, where it is stored.
 template <class Team, class View, class Scratch>
 KOKKOS_INLINE_FUNCTION typename View::non_const_value_type blocked_inclusive_scan(const Team& team, const View& values,
                                                                                   int member, int n,
                                                                                   const Scratch& block_sums) {
   using Value = typename View::non_const_value_type;
+  using Sum = std::conditional_t<std::is_floating_point_v<Value>, double, Value>;
   const int block = scan_block_size(n), num_blocks = scan_num_blocks(n);
   // Both passes read `scan_batch` entries before using them: the same sequential sums, but a GPU thread
   // waits for memory once per batch instead of once per entry (the second pass stores into the column it
   // reads, so the compiler cannot move loads ahead by itself).
   Kokkos::parallel_for(Kokkos::TeamThreadRange(team, num_blocks), [&](const int b) {
     const int end = (b + 1) * block < n ? (b + 1) * block : n;
-    Value sum = 0;
+    Sum sum = 0;
     for (int j0 = b * block; j0 < end; j0 += scan_batch) {
-      Value v[scan_batch];
+      Sum v[scan_batch];
       for (int k = 0; k < scan_batch; ++k) v[k] = j0 + k < end ? values(j0 + k, member) : Value(0);
       for (int k = 0; k < scan_batch; ++k)
         if (j0 + k < end) sum += v[k];
@@ -56,14 +60,14 @@ KOKKOS_INLINE_FUNCTION typename View::non_const_value_type blocked_inclusive_sca
   team.team_barrier();
   Kokkos::parallel_for(Kokkos::TeamThreadRange(team, num_blocks), [&](const int b) {
     const int end = (b + 1) * block < n ? (b + 1) * block : n;
-    Value running = static_cast<Value>(block_sums(b));
+    Sum running = static_cast<Sum>(block_sums(b));
     for (int j0 = b * block; j0 < end; j0 += scan_batch) {
-      Value v[scan_batch];
+      Sum v[scan_batch];
       for (int k = 0; k < scan_batch; ++k) v[k] = j0 + k < end ? values(j0 + k, member) : Value(0);
       for (int k = 0; k < scan_batch; ++k)
         if (j0 + k < end) {
           running += v[k];
-          values(j0 + k, member) = running;
+          values(j0 + k, member) = static_cast<Value>(running);
         }
     }
   });

@@ -40,11 +40,13 @@ KOKKOS_INLINE_FUNCTION constexpr int resample_chunks(int n) {
   return (scan_num_blocks(n) + resample_chunk_blocks(n) - 1) / resample_chunk_blocks(n);
 }
 
-/// What the four kernels read and write. Views are (particle, member[, i]) or (member), LayoutLeft.
-template <class MemSpace>
+/// What the four kernels read and write. Views are (particle, member[, i]) or (member), LayoutLeft; the particles
+/// and log-weights (then cumulative weights) stored as Real.
+template <class MemSpace, class Real = double>
 struct ChunkedResampleData {
-  ParticleBank<MemSpace> x, x_scratch;
-  Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> log_weight;
+  using Stored = Real;
+  ParticleBank<MemSpace, Real> x, x_scratch;
+  ParticleColumn<MemSpace, Real> log_weight;
   Kokkos::View<int**, Kokkos::LayoutLeft, MemSpace> ancestors;      // a_s, kept for inspection and tests
   Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> block_sums;  // (scan block, member)
   BankScalar<double, MemSpace> log_normalizer;
@@ -59,8 +61,8 @@ namespace detail {
 
 /// Loops the team over work items (listed member, chunk), so a fixed league covers any number of members:
 /// body(member, begin, end) with the chunk's particles [begin, end), resample_chunk_blocks(n) whole scan blocks.
-template <class Team, class MemSpace, class Body>
-KOKKOS_INLINE_FUNCTION void for_each_chunk(const Team& team, const ChunkedResampleData<MemSpace>& d, const Body& body) {
+template <class Team, class Data, class Body>
+KOKKOS_INLINE_FUNCTION void for_each_chunk(const Team& team, const Data& d, const Body& body) {
   const int n = d.num_particles, chunks = resample_chunks(n), size = resample_chunk_blocks(n) * scan_block_size(n);
   const int items = d.member_count() * chunks;
   for (int item = team.league_rank(); item < items; item += team.league_size()) {
@@ -78,25 +80,28 @@ KOKKOS_INLINE_FUNCTION void for_each_batch(const Team& team, int begin, int end,
   for (int j0 = begin + team.team_rank(); j0 < end; j0 += resample_batch * threads) body(j0, threads);
 }
 
-/// The weights exp(l - log_normalizer) of particles [begin, end) into team scratch, loaded by the whole team.
-template <class Team, class MemSpace, class Scratch>
-KOKKOS_INLINE_FUNCTION void load_weights(const Team& team, const ChunkedResampleData<MemSpace>& d, int member,
-                                         int begin, int end, const Scratch& w) {
+/// The weights exp(l - log_normalizer) of particles [begin, end) into team scratch, loaded by the whole team, as
+/// the one-team path stores them (rounded to the bank's Real).
+template <class Team, class Data, class Scratch>
+KOKKOS_INLINE_FUNCTION void load_weights(const Team& team, const Data& d, int member, int begin, int end,
+                                         const Scratch& w) {
+  using Real = typename Data::Stored;
   const double log_total = d.log_normalizer(member);
   for_each_batch(team, begin, end, [&](int j0, int stride) {
     double l[resample_batch];
     for (int k = 0; k < resample_batch; ++k) l[k] = j0 + k * stride < end ? d.log_weight(j0 + k * stride, member) : 0.0;
     for (int k = 0; k < resample_batch; ++k)
-      if (j0 + k * stride < end) w(j0 + k * stride - begin) = math::exp(l[k] - log_total);
+      if (j0 + k * stride < end)
+        w(j0 + k * stride - begin) = static_cast<double>(static_cast<Real>(math::exp(l[k] - log_total)));
   });
   team.team_barrier();
 }
 
 /// offsets(k) = the sum of block_sums(0 .. first_block + k - 1, member) in index order (blocked_inclusive_scan's
 /// exclusive prefix), k < blocks. The block sums come into team scratch `sums` first, in one parallel load.
-template <class Team, class MemSpace, class Scratch>
-KOKKOS_INLINE_FUNCTION void block_offsets(const Team& team, const ChunkedResampleData<MemSpace>& d, int member,
-                                          int first_block, int blocks, const Scratch& sums, const Scratch& offsets) {
+template <class Team, class Data, class Scratch>
+KOKKOS_INLINE_FUNCTION void block_offsets(const Team& team, const Data& d, int member, int first_block, int blocks,
+                                          const Scratch& sums, const Scratch& offsets) {
   Kokkos::parallel_for(Kokkos::TeamThreadRange(team, first_block + blocks),
                        [&](const int b) { sums(b) = d.block_sums(b, member); });
   team.team_barrier();
@@ -112,9 +117,9 @@ KOKKOS_INLINE_FUNCTION void block_offsets(const Team& team, const ChunkedResampl
 /// chunk, body(member, b, begin, lo, hi, offset): block b, the chunk's first particle, the block's entries
 /// [lo, hi) of w and (WithOffsets) the sum of the member's block sums before b, else 0. `w` has
 /// scan_num_blocks(n) entries at least; `offsets` resample_chunk_blocks(n).
-template <bool WithOffsets, class Team, class MemSpace, class Scratch, class Body>
-KOKKOS_INLINE_FUNCTION void for_each_weight_block(const Team& team, const ChunkedResampleData<MemSpace>& d,
-                                                  const Scratch& w, const Scratch& offsets, const Body& body) {
+template <bool WithOffsets, class Team, class Data, class Scratch, class Body>
+KOKKOS_INLINE_FUNCTION void for_each_weight_block(const Team& team, const Data& d, const Scratch& w,
+                                                  const Scratch& offsets, const Body& body) {
   for_each_chunk(team, d, [&](int member, int begin, int end) {
     const int block = scan_block_size(d.num_particles);
     const int first_block = begin / block, blocks = (end - begin + block - 1) / block;
@@ -148,12 +153,12 @@ KOKKOS_INLINE_FUNCTION double add_in_order(const Scratch& w, int lo, int hi, dou
 /// Kernels 1 and 2, blocked_inclusive_scan's two passes over each chunk. Pass 1 (Cumulative false):
 /// block_sums(b, member) = the sum of scan block b's weights in particle order. Pass 2: the cumulative weights
 /// C_j, from each block's offset, written over the log-weights.
-template <class ExecSpace, bool Cumulative>
+template <class ExecSpace, bool Cumulative, class Real = double>
 struct ChunkedScanPass {
   using MemSpace = typename ExecSpace::memory_space;
   using Team = typename Kokkos::TeamPolicy<ExecSpace>::member_type;
   using Scratch = Kokkos::View<double*, typename ExecSpace::scratch_memory_space, Kokkos::MemoryUnmanaged>;
-  ChunkedResampleData<MemSpace> d;
+  ChunkedResampleData<MemSpace, Real> d;
 
   /// Team scratch: the chunk's weights (or, before them, the member's block sums), then the blocks' offsets.
   KOKKOS_INLINE_FUNCTION static int weights_size(int n) {
@@ -169,7 +174,8 @@ struct ChunkedScanPass {
     detail::for_each_weight_block<Cumulative>(
         team, d, w, offsets, [&](int member, int b, int begin, int lo, int hi, double offset) {
           if constexpr (Cumulative)
-            detail::add_in_order(w, lo, hi, offset, [&](int j, double c) { d.log_weight(begin + j, member) = c; });
+            detail::add_in_order(w, lo, hi, offset,
+                                 [&](int j, double c) { d.log_weight(begin + j, member) = static_cast<Real>(c); });
           else
             d.block_sums(b, member) = detail::add_in_order(w, lo, hi, 0.0, [](int, double) {});
         });
@@ -178,11 +184,11 @@ struct ChunkedScanPass {
 
 /// Kernel 3: each particle copied into its slots of x_scratch (resample_member's systematic rule, on the
 /// same cumulative weights).
-template <class ExecSpace, int N>
+template <class ExecSpace, int N, class Real = double>
 struct ChunkedSystematicScatter {
   using MemSpace = typename ExecSpace::memory_space;
   using Team = typename Kokkos::TeamPolicy<ExecSpace>::member_type;
-  ChunkedResampleData<MemSpace> d;
+  ChunkedResampleData<MemSpace, Real> d;
 
   KOKKOS_INLINE_FUNCTION void operator()(const Team& team) const {
     detail::for_each_chunk(team, d, [&](int member, int begin, int end) {
@@ -207,7 +213,7 @@ struct ChunkedSystematicScatter {
           const int last = j == n - 1 ? n : detail::ceil_clamped((hi[k] * n) / total - u, n);
           for (int s = first; s < last; ++s) {
             d.ancestors(s, member) = j;
-            for (int i = 0; i < N; ++i) d.x_scratch(s, member, i) = v[k][i];
+            for (int i = 0; i < N; ++i) d.x_scratch(s, member, i) = static_cast<Real>(v[k][i]);
           }
         }
       });
@@ -216,11 +222,11 @@ struct ChunkedSystematicScatter {
 };
 
 /// Kernel 4: the resampled particles back into the bank, log-weights 0 and log-normalizer log N.
-template <class ExecSpace, int N>
+template <class ExecSpace, int N, class Real = double>
 struct ChunkedCopyBack {
   using MemSpace = typename ExecSpace::memory_space;
   using Team = typename Kokkos::TeamPolicy<ExecSpace>::member_type;
-  ChunkedResampleData<MemSpace> d;
+  ChunkedResampleData<MemSpace, Real> d;
 
   KOKKOS_INLINE_FUNCTION void operator()(const Team& team) const {
     detail::for_each_chunk(team, d, [&](int member, int begin, int end) {
@@ -231,7 +237,7 @@ struct ChunkedCopyBack {
             for (int i = 0; i < N; ++i) v[k][i] = d.x_scratch(s0 + k * stride, member, i);
         for (int k = 0; k < resample_batch; ++k)
           if (s0 + k * stride < end) {
-            for (int i = 0; i < N; ++i) d.x(s0 + k * stride, member, i) = v[k][i];
+            for (int i = 0; i < N; ++i) d.x(s0 + k * stride, member, i) = static_cast<Real>(v[k][i]);
             d.log_weight(s0 + k * stride, member) = 0.0;
           }
       });
@@ -244,23 +250,24 @@ struct ChunkedCopyBack {
 
 /// Resamples the listed members systematically (d.members, d.member_count on the device). `team_size`:
 /// threads per team; `league`: teams, each looping over the work items. No fence.
-template <int N, class ExecSpace>
-void chunked_systematic_resample(const ExecSpace& space, const ChunkedResampleData<typename ExecSpace::memory_space>& d,
-                                 int team_size, int league) {
+template <int N, class ExecSpace, class Real>
+void chunked_systematic_resample(const ExecSpace& space,
+                                 const ChunkedResampleData<typename ExecSpace::memory_space, Real>& d, int team_size,
+                                 int league) {
   KUSHNER_REQUIRE(chunked_resample_supports(d.num_particles),
                   "chunked resampling: " << d.num_particles << " particles per member is more than it supports");
   using Policy = Kokkos::TeamPolicy<ExecSpace>;
-  const std::size_t scratch = ChunkedScanPass<ExecSpace, false>::scratch_bytes(d.num_particles);
+  const std::size_t scratch = ChunkedScanPass<ExecSpace, false, Real>::scratch_bytes(d.num_particles);
   Kokkos::parallel_for("kushner::resample_block_sums",
                        Policy(space, league, team_size).set_scratch_size(0, Kokkos::PerTeam(scratch)),
-                       ChunkedScanPass<ExecSpace, false>{d});
+                       ChunkedScanPass<ExecSpace, false, Real>{d});
   Kokkos::parallel_for("kushner::resample_cumulative",
                        Policy(space, league, team_size).set_scratch_size(0, Kokkos::PerTeam(scratch)),
-                       ChunkedScanPass<ExecSpace, true>{d});
+                       ChunkedScanPass<ExecSpace, true, Real>{d});
   Kokkos::parallel_for("kushner::resample_scatter", Policy(space, league, team_size),
-                       ChunkedSystematicScatter<ExecSpace, N>{d});
+                       ChunkedSystematicScatter<ExecSpace, N, Real>{d});
   Kokkos::parallel_for("kushner::resample_copy_back", Policy(space, league, team_size),
-                       ChunkedCopyBack<ExecSpace, N>{d});
+                       ChunkedCopyBack<ExecSpace, N, Real>{d});
 }
 
 }  // namespace kushner

@@ -7,10 +7,10 @@
 
 namespace kushner {
 
-template <int N, class MemSpace>
+template <int N, class MemSpace, class Real = double>
 struct CopyListedMembers {
-  ParticleBank<MemSpace> from_x, to_x;                                  // (particle, member, i)
-  Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> from_lw, to_lw;  // (particle, member)
+  ParticleBank<MemSpace, Real> from_x, to_x;      // (particle, member, i)
+  ParticleColumn<MemSpace, Real> from_lw, to_lw;  // (particle, member)
   Kokkos::View<const int*, MemSpace> members;
   Kokkos::View<const int, MemSpace> member_count;
   int num_particles;
@@ -27,8 +27,8 @@ struct CopyListedMembers {
 };
 
 /// to <- from for the members listed in members(0 .. member_count() - 1). No fence.
-template <int N, class ExecSpace, class MemSpace = typename ExecSpace::memory_space>
-void copy_listed_members(const ExecSpace& space, const CopyListedMembers<N, MemSpace>& copy) {
+template <int N, class ExecSpace, class MemSpace, class Real>
+void copy_listed_members(const ExecSpace& space, const CopyListedMembers<N, MemSpace, Real>& copy) {
   Kokkos::parallel_for("kushner::copy_listed_members", Kokkos::RangePolicy<ExecSpace>(space, 0, copy.work_items), copy);
 }
 

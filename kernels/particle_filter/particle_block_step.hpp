@@ -10,6 +10,7 @@
 #include <Kokkos_Core.hpp>
 
 #include <cstdint>
+#include <type_traits>
 
 namespace kushner {
 
@@ -29,16 +30,35 @@ inline void draw_block_normals(const RngKey& key, int member, int first_pair, in
 
 /// The host kernel's work for one block: a function of the model and the data only (not of the execution
 /// space), so Serial and OpenMP run the same machine code and give the same bits (kernels/for_each_member.hpp).
-template <bool Initialize, class Model>
-KUSHNER_SAME_CODE_FOR_ALL_CALLERS void particle_block_host(const ParticleStepData<Model, Kokkos::HostSpace>& d,
+template <bool Initialize, class Model, class Real>
+KUSHNER_SAME_CODE_FOR_ALL_CALLERS void particle_block_host(const ParticleStepData<Model, Kokkos::HostSpace, Real>& d,
                                                            int member, int block) {
   constexpr int n = Model::state_dim;
   constexpr int B = host_particle_block;
   const int begin = block * B;
   const int count = d.num_particles - begin < B ? d.num_particles - begin : B;
+  // The particle loop runs on doubles: float storage (fp32) is widened into block buffers first and narrowed back
+  // after it, in loops of their own. Mixing the widths in one SIMD loop made GCC pick 16 float lanes, for which
+  // libmvec has no double sin or exp, so it called the scalar ones (4x slower).
+  constexpr bool widen = !std::is_same_v<Real, double>;
+  double widened_x[widen ? n : 1][widen ? B : 1], widened_lw[widen ? B : 1];
   double* xs[n];
-  for (int i = 0; i < n; ++i) xs[i] = &d.x(begin, member, i);
-  double* lw = &d.log_weight(begin, member);
+  double* lw;
+  if constexpr (widen) {
+    for (int i = 0; i < n; ++i) {
+      const Real* column = &d.x(begin, member, i);
+      KUSHNER_SIMD
+      for (int j = 0; j < count; ++j) widened_x[i][j] = column[j];
+      xs[i] = widened_x[i];
+    }
+    const Real* column = &d.log_weight(begin, member);
+    KUSHNER_SIMD
+    for (int j = 0; j < count; ++j) widened_lw[j] = column[j];
+    lw = widened_lw;
+  } else {
+    for (int i = 0; i < n; ++i) xs[i] = &d.x(begin, member, i);
+    lw = &d.log_weight(begin, member);
+  }
   const double log_normalizer = d.initialize ? 0.0 : d.log_normalizer(member);
   const Vec<Model::obs_dim> vinv_dy = d.initialize ? Vec<Model::obs_dim>::zero() : precision_times_dy(d, member);
   double l[B], e[B], dx[n][B];
@@ -72,12 +92,32 @@ KUSHNER_SAME_CODE_FOR_ALL_CALLERS void particle_block_host(const ParticleStepDat
     KUSHNER_UNROLL_FULLY
     for (int i = 0; i < K; ++i) zj[i] = z[i][j];
     const double uj = draws_uniform<Model, Initialize> ? u[j] : 0.0;
-    const double lj = update_particle<Initialize>(d, d.t, d.observation_precision, zj, uj, lw[j], log_normalizer,
-                                                  vinv_dy, control, xj);
+    const double lj = detail::update_particle_unrounded<Initialize>(d, d.t, d.observation_precision, zj, uj, lw[j],
+                                                                    log_normalizer, vinv_dy, control, xj);
     KUSHNER_UNROLL_FULLY
     for (int i = 0; i < n; ++i) xs[i][j] = xj[i];
     lw[j] = lj;
     l[j] = lj;
+  }
+  if constexpr (widen) {   // rounded as stored (round_to_storage's rule), in simple loops of their own (vectorized)
+    double not_finite[B];  // NaN where a rounded coordinate is not finite (r - r), else 0
+    KUSHNER_SIMD
+    for (int j = 0; j < count; ++j) not_finite[j] = 0.0;
+    for (int i = 0; i < n; ++i) {
+      KUSHNER_SIMD
+      for (int j = 0; j < count; ++j) {
+        const double r = stored_value<Real>(xs[i][j]);
+        xs[i][j] = r;
+        not_finite[j] += r - r;
+      }
+    }
+    KUSHNER_SIMD
+    for (int j = 0; j < count; ++j) {
+      // -inf added where a coordinate is not finite: a select of constants, which GCC vectorizes (l is finite or
+      // -inf, so the sum is l or -inf)
+      const double dead = not_finite[j] == 0.0 ? 0.0 : -math::infinity();
+      l[j] = lw[j] = stored_value<Real>(l[j]) + dead;
+    }
   }
   double m = -math::infinity();
   KUSHNER_SIMD_REDUCTION(max : m)
@@ -115,12 +155,22 @@ KUSHNER_SAME_CODE_FOR_ALL_CALLERS void particle_block_host(const ParticleStepDat
     }
   }
   w.store(d.partials, block, member);
+  if constexpr (widen) {  // the values are already rounded to float (above): exact
+    for (int i = 0; i < n; ++i) {
+      Real* column = &d.x(begin, member, i);
+      KUSHNER_SIMD
+      for (int j = 0; j < count; ++j) column[j] = static_cast<Real>(xs[i][j]);
+    }
+    Real* column = &d.log_weight(begin, member);
+    KUSHNER_SIMD
+    for (int j = 0; j < count; ++j) column[j] = static_cast<Real>(lw[j]);
+  }
 }
 
 /// Host kernel: one work item per (block, member).
-template <class Model>
+template <class Model, class Real = double>
 struct ParticleBlockStep {
-  ParticleStepData<Model, Kokkos::HostSpace> d;
+  ParticleStepData<Model, Kokkos::HostSpace, Real> d;
   int blocks_per_member;
   void operator()(const int item) const {
     const int member = item / blocks_per_member, block = item % blocks_per_member;

@@ -9,21 +9,26 @@ namespace kushner {
 /// noise and initial states drawn in float from the same Philox blocks (kernels/rng.hpp): a GPU's fp32 log, sqrt
 /// and sincospi cost a fraction of the fp64 ones (H200: 1.10x the fp64 step, 1.21x with step_pair; the step is
 /// bound by the card's power cap: perf/particle_filter.md). The normals agree with fp64's to about 1e-7 and are cut
-/// at 5.77 standard deviations of the radius (probability 2^-24 beyond); tests/test_particle_filter_references.cpp
-/// checks both precisions for bias against exact filters.
-enum class ParticlePrecision { fp64, mixed };
+/// at 5.77 standard deviations of the radius (probability 2^-24 beyond). fp32: mixed's normals, and the particles
+/// and their log-weights (and, while resampling, cumulative weights) stored in float: half the bytes moved per
+/// particle-step, and about half the memory per particle (the ancestor index stays an int); each particle's step is
+/// computed in double from the stored values and rounded once where it is stored, and the normalizers, moments and
+/// every sum are taken in double. tests/test_particle_filter_references.cpp checks every precision for bias against
+/// exact filters.
+enum class ParticlePrecision { fp64, mixed, fp32 };
 
 inline const char* to_string(ParticlePrecision p) {
   switch (p) {
     case ParticlePrecision::fp64: return "fp64";
     case ParticlePrecision::mixed: return "mixed";
+    case ParticlePrecision::fp32: return "fp32";
   }
   return "unknown";
 }
 
 /// The precision called `name`, if there is one.
 inline std::optional<ParticlePrecision> particle_precision_named(const std::string& name) {
-  for (auto p : {ParticlePrecision::fp64, ParticlePrecision::mixed})
+  for (auto p : {ParticlePrecision::fp64, ParticlePrecision::mixed, ParticlePrecision::fp32})
     if (name == to_string(p)) return p;
   return std::nullopt;
 }

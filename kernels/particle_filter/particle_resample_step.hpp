@@ -14,13 +14,13 @@
 
 namespace kushner {
 
-template <int N, class ExecSpace>
+template <int N, class ExecSpace, class Real = double>
 struct ParticleResampleStep {
   using MemSpace = typename ExecSpace::memory_space;
   using Team = typename Kokkos::TeamPolicy<ExecSpace>::member_type;
   using Scratch = Kokkos::View<double*, typename ExecSpace::scratch_memory_space, Kokkos::MemoryUnmanaged>;
-  ParticleBank<MemSpace> x, x_scratch;  // (particle, member, i)
-  ResamplingWorkspace<MemSpace> ws;     // ws.cumulative is the log-weight bank
+  ParticleBank<MemSpace, Real> x, x_scratch;  // (particle, member, i)
+  ResamplingWorkspace<MemSpace, Real> ws;     // ws.cumulative is the log-weight bank
   BankScalar<double, MemSpace> log_normalizer;
   BankScalar<int, MemSpace> resample;
   int num_particles;
@@ -41,7 +41,8 @@ struct ParticleResampleStep {
       double l[batch];
       for (int k = 0; k < batch; ++k) l[k] = j0 + k * threads < n ? ws.cumulative(j0 + k * threads, member) : 0.0;
       for (int k = 0; k < batch; ++k)  // exp(-inf) = 0: dead particles
-        if (j0 + k * threads < n) ws.cumulative(j0 + k * threads, member) = math::exp(l[k] - log_total);
+        if (j0 + k * threads < n)
+          ws.cumulative(j0 + k * threads, member) = static_cast<Real>(math::exp(l[k] - log_total));
     }
     team.team_barrier();
     const Scratch block_sums(team.team_scratch(0), scan_num_blocks(n));
@@ -54,7 +55,7 @@ struct ParticleResampleStep {
         for (int i = 0; i < N; ++i) v[k][i] = s0 + k * threads < n ? x(a[k], member, i) : 0.0;
       for (int k = 0; k < batch; ++k)
         if (s0 + k * threads < n)
-          for (int i = 0; i < N; ++i) x_scratch(s0 + k * threads, member, i) = v[k][i];
+          for (int i = 0; i < N; ++i) x_scratch(s0 + k * threads, member, i) = static_cast<Real>(v[k][i]);
     }
     team.team_barrier();
     for (int s0 = rank; s0 < n; s0 += batch * threads) {
@@ -63,7 +64,7 @@ struct ParticleResampleStep {
         for (int i = 0; i < N; ++i) v[k][i] = s0 + k * threads < n ? x_scratch(s0 + k * threads, member, i) : 0.0;
       for (int k = 0; k < batch; ++k)
         if (s0 + k * threads < n) {
-          for (int i = 0; i < N; ++i) x(s0 + k * threads, member, i) = v[k][i];
+          for (int i = 0; i < N; ++i) x(s0 + k * threads, member, i) = static_cast<Real>(v[k][i]);
           ws.cumulative(s0 + k * threads, member) = 0.0;
         }
     }

@@ -40,8 +40,8 @@ KOKKOS_INLINE_FUNCTION int batch_particle(int base, int k, int threads) {
 
 /// Loads the batch's particles (and log-weights, unless initializing) from one member's columns: xm[j + i * stride]
 /// and lwm[j]. Slots past `end` are left as they are.
-template <int N, bool Initialize>
-KOKKOS_INLINE_FUNCTION void load_particle_batch(const double* xm, const double* lwm, std::size_t stride, int base,
+template <int N, bool Initialize, class Real>
+KOKKOS_INLINE_FUNCTION void load_particle_batch(const Real* xm, const Real* lwm, std::size_t stride, int base,
                                                 int threads, int end, Vec<N>* x, double* lw) {
   KUSHNER_DEVICE_UNROLL
   for (int k = 0; k < 2 * device_pairs_per_batch; ++k) {

@@ -12,14 +12,14 @@
 
 namespace kushner {
 
-template <class Model, class ExecSpace>
+template <class Model, class ExecSpace, class Real = double>
 struct ParticleTeamPairStep {
   using MemSpace = typename ExecSpace::memory_space;
   using Team = typename Kokkos::TeamPolicy<ExecSpace>::member_type;
   using Scratch = Kokkos::View<double*, typename ExecSpace::scratch_memory_space, Kokkos::MemoryUnmanaged>;
   static constexpr int n = Model::state_dim, p = Model::obs_dim;
-  ParticleStepData<Model, MemSpace> d;       // step k: its inputs, increments and partials
-  ParticleSecondStep<Model, MemSpace> next;  // step k + 1: its outputs, increments and partials
+  ParticleStepData<Model, MemSpace, Real> d;       // step k: its inputs, increments and partials
+  ParticleSecondStep<Model, MemSpace, Real> next;  // step k + 1: its outputs, increments and partials
   // No control: a closed loop's second control depends on the first step's posterior (step_pair refuses one).
   KOKKOS_INLINE_FUNCTION static typename Model::Control uncontrolled() { return Model::Control::zero(); }
 
@@ -69,10 +69,10 @@ struct ParticleTeamPairStep {
     constexpr int K = particle_draw_dim<Model, false>;
     const double log_normalizer = d.log_normalizer(member);
     double top[2] = {-math::infinity(), -math::infinity()};
-    const double* const xm = &d.x(0, member, 0);
-    const double* const lwm = &d.log_weight(0, member);
-    double* const xo = &next.x(0, member, 0);
-    double* const lwo = &next.log_weight(0, member);
+    const Real* const xm = &d.x(0, member, 0);
+    const Real* const lwm = &d.log_weight(0, member);
+    Real* const xo = &next.x(0, member, 0);
+    Real* const lwo = &next.log_weight(0, member);
     const std::size_t stride = d.x.stride_2();  // the same for next.x
     const RngKey key = particle_draw_key<false>(d);
     for (int base = c.begin / 2 + c.rank; base < (c.end + 1) / 2; base += device_pairs_per_batch * c.threads) {
@@ -92,8 +92,8 @@ struct ParticleTeamPairStep {
                                                   s == 0 ? log_normalizer : 0.0, vinv_dy[s], uncontrolled(), x[k]);
           if (s == 1) {
             KUSHNER_DEVICE_UNROLL
-            for (int i = 0; i < n; ++i) xo[j + i * stride] = x[k][i];
-            lwo[j] = l;
+            for (int i = 0; i < n; ++i) xo[j + i * stride] = static_cast<Real>(x[k][i]);
+            lwo[j] = static_cast<Real>(l);
           }
           lw[k] = l;
           top[s] = l > top[s] ? l : top[s];

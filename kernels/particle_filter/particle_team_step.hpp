@@ -8,13 +8,13 @@
 
 namespace kushner {
 
-template <class Model, class ExecSpace>
+template <class Model, class ExecSpace, class Real = double>
 struct ParticleTeamStep {
   using MemSpace = typename ExecSpace::memory_space;
   using Team = typename Kokkos::TeamPolicy<ExecSpace>::member_type;
   using Scratch = Kokkos::View<double*, typename ExecSpace::scratch_memory_space, Kokkos::MemoryUnmanaged>;
   static constexpr int n = Model::state_dim, p = Model::obs_dim;
-  ParticleStepData<Model, MemSpace> d;
+  ParticleStepData<Model, MemSpace, Real> d;
 
   static std::size_t scratch_bytes(int team_size) { return team_sum_scratch_bytes<n>(team_size); }
 
@@ -53,8 +53,8 @@ struct ParticleTeamStep {
     const double log_normalizer = Initialize ? 0.0 : d.log_normalizer(member);
     double top = -math::infinity();
     // The member's columns as pointers: one 64-bit address computation per thread, not per access.
-    double* const xm = &d.x(0, member, 0);
-    double* const lwm = &d.log_weight(0, member);
+    Real* const xm = &d.x(0, member, 0);
+    Real* const lwm = &d.log_weight(0, member);
     const std::size_t stride = d.x.stride_2();  // LayoutLeft: x(j, member, i) = xm[j + i * stride]
     const RngKey key = particle_draw_key<Initialize>(d);
     const std::uint32_t step = particle_draw_step<Initialize>(d);
@@ -73,8 +73,8 @@ struct ParticleTeamStep {
         const double l = update_particle<Initialize>(d, d.t, d.observation_precision, z[k], u[k], lw[k], log_normalizer,
                                                      vinv_dy, control, x[k]);
         KUSHNER_DEVICE_UNROLL
-        for (int i = 0; i < n; ++i) xm[j + i * stride] = x[k][i];
-        lwm[j] = l;
+        for (int i = 0; i < n; ++i) xm[j + i * stride] = static_cast<Real>(x[k][i]);
+        lwm[j] = static_cast<Real>(l);
         top = l > top ? l : top;
         add_shifted_particle(l - shift, x[k] - ref, w);
       }

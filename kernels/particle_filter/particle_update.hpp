@@ -22,19 +22,23 @@
 #include <Kokkos_Core.hpp>
 
 #include <cstdint>
+#include <limits>
+#include <type_traits>
 
 namespace kushner {
 
-/// Everything one step reads and writes. Views are (particle, member[, i]) or (member[, i]), LayoutLeft.
-template <class Model, class MemSpace>
+/// Everything one step reads and writes. Views are (particle, member[, i]) or (member[, i]), LayoutLeft. The
+/// particles and log-weights are stored as Real (float in the fp32 precision: particle_precision.hpp); a particle's
+/// step computes in double.
+template <class Model, class MemSpace, class Real = double>
 struct ParticleStepData {
   static constexpr int n = Model::state_dim, p = Model::obs_dim, q = Model::noise_dim;
   Model model;
-  ParticleBank<MemSpace> x;                                         // (particle, member, i)
-  Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> log_weight;  // (particle, member)
-  BankScalar<double, MemSpace> log_normalizer;                      // log sum_j exp(log_weight_j)
-  BankVector<MemSpace> reference;                                   // (member, i): previous posterior mean
-  BankVector<MemSpace> dy;                                          // (member, j): this step's increments
+  ParticleBank<MemSpace, Real> x;               // (particle, member, i)
+  ParticleColumn<MemSpace, Real> log_weight;    // (particle, member)
+  BankScalar<double, MemSpace> log_normalizer;  // log sum_j exp(log_weight_j)
+  BankVector<MemSpace> reference;               // (member, i): previous posterior mean
+  BankVector<MemSpace> dy;                      // (member, j): this step's increments
   BankScalar<Status, MemSpace> status;
   BankVector<MemSpace> control;  // (member, j): the control over this step (closed loop); empty: none
   Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace> partials;  // (block, member, k)
@@ -47,17 +51,17 @@ struct ParticleStepData {
   std::uint32_t step = 0;
   int num_particles = 0, block_size = 0;
   bool initialize = false;    // sample the initial law instead of propagating; no observation
-  bool fp32_normals = false;  // the `mixed` precision (particle_precision.hpp)
+  bool fp32_normals = false;  // the `mixed` and `fp32` precisions (particle_precision.hpp)
 };
 
 /// The second step of a fused pair (particle_team_pair_step.hpp): step + 1, over [t, t + dt]. The pair reads the
 /// first step's x and log_weight and writes x and log_weight here (same layout), so that its first step can be
 /// recomputed from untouched inputs.
-template <class Model, class MemSpace>
+template <class Model, class MemSpace, class Real = double>
 struct ParticleSecondStep {
   static constexpr int p = Model::obs_dim;
-  ParticleBank<MemSpace> x;
-  Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> log_weight;
+  ParticleBank<MemSpace, Real> x;
+  ParticleColumn<MemSpace, Real> log_weight;
   BankVector<MemSpace> dy;
   Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace> partials;
   Mat<p, p> observation_precision;
@@ -72,12 +76,12 @@ template <class Model, bool Initialize>
 constexpr bool draws_uniform = !Initialize && (Model::discrete_time || has_exact_transition<Model>::value);
 
 /// The key and step of the particles' draws: their initial states, or step d.step.
-template <bool Initialize, class Model, class MemSpace>
-KOKKOS_INLINE_FUNCTION RngKey particle_draw_key(const ParticleStepData<Model, MemSpace>& d) {
+template <bool Initialize, class Model, class MemSpace, class Real>
+KOKKOS_INLINE_FUNCTION RngKey particle_draw_key(const ParticleStepData<Model, MemSpace, Real>& d) {
   return RngKey{d.seed, Initialize ? Stream::particle_initial : Stream::particle_noise};
 }
-template <bool Initialize, class Model, class MemSpace>
-KOKKOS_INLINE_FUNCTION std::uint32_t particle_draw_step(const ParticleStepData<Model, MemSpace>& d) {
+template <bool Initialize, class Model, class MemSpace, class Real>
+KOKKOS_INLINE_FUNCTION std::uint32_t particle_draw_step(const ParticleStepData<Model, MemSpace, Real>& d) {
   return Initialize ? 0 : d.step;
 }
 
@@ -101,14 +105,15 @@ KOKKOS_INLINE_FUNCTION void draw_particle_pair(const RngKey& key, int member, in
 }
 
 /// V^{-1} dy of one member: the only observation term the likelihood needs besides h(x).
-template <class Model, class MemSpace>
-KOKKOS_INLINE_FUNCTION Vec<Model::obs_dim> precision_times_dy(const ParticleStepData<Model, MemSpace>& d, int member) {
+template <class Model, class MemSpace, class Real>
+KOKKOS_INLINE_FUNCTION Vec<Model::obs_dim> precision_times_dy(const ParticleStepData<Model, MemSpace, Real>& d,
+                                                              int member) {
   return d.observation_precision * load<Model::obs_dim>(d.dy, member);
 }
 
 /// The control a member's particles are driven by over this step (zero outside a closed loop).
-template <class Model, class MemSpace>
-KOKKOS_INLINE_FUNCTION typename Model::Control particle_control(const ParticleStepData<Model, MemSpace>& d,
+template <class Model, class MemSpace, class Real>
+KOKKOS_INLINE_FUNCTION typename Model::Control particle_control(const ParticleStepData<Model, MemSpace, Real>& d,
                                                                 int member) {
   if constexpr (Model::control_dim > 0) {
     if (d.control.extent(0) > 0) return load<Model::control_dim>(d.control, member);
@@ -116,17 +121,44 @@ KOKKOS_INLINE_FUNCTION typename Model::Control particle_control(const ParticleSt
   return Model::Control::zero();
 }
 
-/// Moves one particle (x in, x out) over [t, t + dt] with its draws (normals z, uniform u) and returns its new
-/// log-weight, normalized by the member's previous log-normalizer; -inf for a particle that left the finite
-/// numbers. `precision` is V^{-1} at t; `control` is the member's (particle_control). A discrete-time model's
-/// precision is the identity, so `vinv_dy` is z[k+1] itself.
-template <bool Initialize, class Model, class MemSpace>
-KOKKOS_INLINE_FUNCTION double update_particle(const ParticleStepData<Model, MemSpace>& d, double t,
-                                              const Mat<Model::obs_dim, Model::obs_dim>& precision,
-                                              const Vec<particle_draw_dim<Model, Initialize>>& z, double u,
-                                              double log_weight, double log_normalizer,
-                                              const Vec<Model::obs_dim>& vinv_dy,
-                                              const typename Model::Control& control, Vec<Model::state_dim>& x) {
+/// `v` as it is stored in a Real: rounded to float in the fp32 precision, so that what a kernel keeps in registers
+/// (and sums into moments, or steps again in a fused pair) is what it stores.
+template <class Real>
+KOKKOS_INLINE_FUNCTION double stored_value(double v) {
+  // IEEE 754 conversion: to nearest, and past float's range to the infinity of the value's sign.
+  static_assert(std::numeric_limits<Real>::is_iec559, "particles are stored in IEEE 754 numbers");
+  return static_cast<double>(static_cast<Real>(v));
+}
+template <class Real, int N>
+KOKKOS_INLINE_FUNCTION Vec<N> stored_value(Vec<N> v) {
+  KUSHNER_UNROLL_FULLY
+  for (int i = 0; i < N; ++i) v[i] = stored_value<Real>(v[i]);
+  return v;
+}
+
+/// A particle's new state x and log-weight l as the bank stores them (stored_value); returns l, or -inf where x
+/// left float's range (stored as inf: the particle has left the numbers). Nothing to do for double. The host's
+/// block kernel applies the same rule in loops of its own (particle_block_step.hpp: GCC vectorizes those).
+template <class Real, int N>
+KOKKOS_INLINE_FUNCTION double round_to_storage(Vec<N>& x, double l) {
+  if constexpr (std::is_same_v<Real, double>) {
+    return l;
+  } else {
+    x = stored_value<Real>(x);
+    bool finite = true;
+    KUSHNER_UNROLL_FULLY
+    for (int i = 0; i < N; ++i) finite = finite & math::is_finite(x[i]);
+    return finite ? stored_value<Real>(l) : -math::infinity();
+  }
+}
+
+namespace detail {
+/// update_particle before its results are rounded to the bank's storage.
+template <bool Initialize, class Model, class MemSpace, class Real>
+KOKKOS_INLINE_FUNCTION double update_particle_unrounded(
+    const ParticleStepData<Model, MemSpace, Real>& d, double t, const Mat<Model::obs_dim, Model::obs_dim>& precision,
+    const Vec<particle_draw_dim<Model, Initialize>>& z, double u, double log_weight, double log_normalizer,
+    const Vec<Model::obs_dim>& vinv_dy, const typename Model::Control& control, Vec<Model::state_dim>& x) {
   constexpr int n = Model::state_dim, p = Model::obs_dim;
   if constexpr (Initialize) {
     x = d.initial_mean + d.initial_root * z;
@@ -153,6 +185,24 @@ KOKKOS_INLINE_FUNCTION double update_particle(const ParticleStepData<Model, MemS
     for (int i = 0; i < n; ++i) finite = finite & math::is_finite(x[i]);  // `&`: no branch, so GCC can vectorize
     return finite ? l : -math::infinity();
   }
+}
+}  // namespace detail
+
+/// Moves one particle (x in, x out) over [t, t + dt] with its draws (normals z, uniform u) and returns its new
+/// log-weight, normalized by the member's previous log-normalizer; -inf for a particle that left the finite
+/// numbers. `precision` is V^{-1} at t; `control` is the member's (particle_control). A discrete-time model's
+/// precision is the identity, so `vinv_dy` is z[k+1] itself. The step computes in double; x and the log-weight
+/// come out as the bank stores them (stored_value).
+template <bool Initialize, class Model, class MemSpace, class Real>
+KOKKOS_INLINE_FUNCTION double update_particle(const ParticleStepData<Model, MemSpace, Real>& d, double t,
+                                              const Mat<Model::obs_dim, Model::obs_dim>& precision,
+                                              const Vec<particle_draw_dim<Model, Initialize>>& z, double u,
+                                              double log_weight, double log_normalizer,
+                                              const Vec<Model::obs_dim>& vinv_dy,
+                                              const typename Model::Control& control, Vec<Model::state_dim>& x) {
+  const double l = detail::update_particle_unrounded<Initialize>(d, t, precision, z, u, log_weight, log_normalizer,
+                                                                 vinv_dy, control, x);
+  return round_to_storage<Real>(x, l);
 }
 
 /// The largest log-likelihood increment any particle can get from an increment dy: h.a - (dt/2) h^T V^-1 h

@@ -10,6 +10,7 @@
 // Uniforms come from Stream::resampling with counter {member, slot, step, 0} (systematic: slot 0), so the
 // indices depend only on the weights, the seed, the member and the step. Cumulative weights come from
 // blocked_inclusive_scan, whose order is fixed: the same weights give the same indices on every backend.
+#include "kernels/bank.hpp"
 #include "kernels/particle_filter/blocked_scan.hpp"
 #include "kernels/particle_filter/resampling_scheme.hpp"
 #include "kernels/rng.hpp"
@@ -21,12 +22,13 @@
 
 namespace kushner {
 
-/// Views a team needs to resample member columns: (particle, member), particle index contiguous.
-template <class MemSpace>
+/// Views a team needs to resample member columns: (particle, member), particle index contiguous. The weights and
+/// their cumulative sums are stored as Real (summed in double: blocked_inclusive_scan).
+template <class MemSpace, class Real = double>
 struct ResamplingWorkspace {
-  Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> cumulative;  // weights in, cumulative weights out
-  Kokkos::View<int**, Kokkos::LayoutLeft, MemSpace> ancestors;      // a_s
-  Kokkos::View<int**, Kokkos::LayoutLeft, MemSpace> copies;         // residual: floor(N w_j), then their prefix
+  ParticleColumn<MemSpace, Real> cumulative;                    // weights in, cumulative weights out
+  Kokkos::View<int**, Kokkos::LayoutLeft, MemSpace> ancestors;  // a_s
+  Kokkos::View<int**, Kokkos::LayoutLeft, MemSpace> copies;     // residual: floor(N w_j), then their prefix
 };
 
 namespace detail {
@@ -69,8 +71,8 @@ KOKKOS_INLINE_FUNCTION double resampling_uniform(Seed seed, int member, int slot
 /// Team-level resampling of member `member`: ws.cumulative(., member) holds n non-negative weights with a
 /// positive sum on entry (cumulative sums on exit); ws.ancestors(., member) receives the n ancestors.
 /// `block_sums`: team scratch with scan_num_blocks(n) doubles.
-template <class Team, class MemSpace, class Scratch>
-KOKKOS_INLINE_FUNCTION void resample_member(const Team& team, const ResamplingWorkspace<MemSpace>& ws, int member,
+template <class Team, class MemSpace, class Real, class Scratch>
+KOKKOS_INLINE_FUNCTION void resample_member(const Team& team, const ResamplingWorkspace<MemSpace, Real>& ws, int member,
                                             int n, ResamplingScheme scheme, Seed seed, std::uint32_t step,
                                             const Scratch& block_sums) {
   const auto& c = ws.cumulative;
@@ -158,11 +160,11 @@ constexpr int resampling_team_size() {
   return std::is_same<typename ExecSpace::memory_space, Kokkos::HostSpace>::value ? 1 : 256;
 }
 
-template <class ExecSpace>
+template <class ExecSpace, class Real = double>
 struct ResampleMembers {
   using MemSpace = typename ExecSpace::memory_space;
   using Scratch = Kokkos::View<double*, typename ExecSpace::scratch_memory_space, Kokkos::MemoryUnmanaged>;
-  ResamplingWorkspace<MemSpace> ws;
+  ResamplingWorkspace<MemSpace, Real> ws;
   int num_particles;
   ResamplingScheme scheme;
   Seed seed;
@@ -177,8 +179,8 @@ struct ResampleMembers {
 /// Resamples every member: ws.cumulative (particle, member) holds each member's non-negative weights (any
 /// positive sum; overwritten), ws.ancestors receives the indices. ws.copies is needed for `residual` only.
 /// `team_size` 0 means resampling_team_size<ExecSpace>(). No fence.
-template <class ExecSpace, class MemSpace>
-void resample_members(const ExecSpace& space, const ResamplingWorkspace<MemSpace>& ws, ResamplingScheme scheme,
+template <class ExecSpace, class MemSpace, class Real>
+void resample_members(const ExecSpace& space, const ResamplingWorkspace<MemSpace, Real>& ws, ResamplingScheme scheme,
                       Seed seed, std::uint32_t step, int team_size = 0) {
   const int n = ws.cumulative.extent_int(0), members = ws.cumulative.extent_int(1);
   KUSHNER_REQUIRE(n > 0 && ws.ancestors.extent_int(0) == n && ws.ancestors.extent_int(1) == members,
@@ -189,7 +191,8 @@ void resample_members(const ExecSpace& space, const ResamplingWorkspace<MemSpace
       "residual resampling needs a copies workspace of the weights' shape");
   Kokkos::TeamPolicy<ExecSpace> policy(space, members, team_size > 0 ? team_size : resampling_team_size<ExecSpace>());
   policy.set_scratch_size(0, Kokkos::PerTeam(sizeof(double) * scan_num_blocks(n)));
-  Kokkos::parallel_for("kushner::resample_members", policy, ResampleMembers<ExecSpace>{ws, n, scheme, seed, step});
+  Kokkos::parallel_for("kushner::resample_members", policy,
+                       ResampleMembers<ExecSpace, Real>{ws, n, scheme, seed, step});
 }
 
 }  // namespace kushner

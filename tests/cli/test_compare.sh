@@ -81,20 +81,26 @@ assert f["EXACT"]["rmse_ref"] < 0.05, f["EXACT"]
 assert abs(f["EXACT"]["rmse_truth"] - f["PF"]["rmse_truth"]) < 0.05, (f["EXACT"], f["PF"])
 assert f["PF"]["estimator"]["precision"] == "fp64", f["PF"]
 PY
-# The mixed precision (normals in fp32): recorded, and as close to the grid filter as fp64's particle filter.
-run_kushner "$work/m" filter --model sine --filters QLF,PF,EXACT --members 8 --particles 2048 --T 0.5 --dt 1e-2 \
-  --precision mixed --quiet --out "$work/m1"
-[ "$rc" -eq 0 ] || fail "filter with --precision mixed failed: $(cat "$work/m.err")"
-python3 - "$work/m1/summary.json" "$work/e1/summary.json" <<'PY' || fail "mixed precision PF"
+# The coarser precisions, each against the next finer one's run (mixed against fp64's e1, fp32 against mixed's):
+# recorded, and as close to the grid filter as fp64's particle filter. mixed draws the same Philox normals in fp32,
+# fp32 also stores the particles and log-weights in float: the two particle filters' errors agree far below their
+# noise floor, but not to the bit.
+finer=e1
+for precision in mixed fp32; do
+  run_kushner "$work/m" filter --model sine --filters QLF,PF,EXACT --members 8 --particles 2048 --T 0.5 --dt 1e-2 \
+    --precision $precision --quiet --out "$work/$precision"
+  [ "$rc" -eq 0 ] || fail "filter with --precision $precision failed: $(cat "$work/m.err")"
+  python3 - "$work/$precision/summary.json" "$work/$finer/summary.json" $precision <<'PY' || fail "$precision PF"
 import json, sys
-mixed, fp64 = (json.load(open(p))["filters"] for p in sys.argv[1:3])
-assert mixed["PF"]["estimator"]["precision"] == "mixed", mixed["PF"]
-assert mixed["EXACT"]["rmse_ref"] < 0.05, mixed["EXACT"]
-# The same Philox draws to float rounding: the two particle filters' errors agree far below their noise floor.
-assert abs(mixed["PF"]["rmse_truth"] - fp64["PF"]["rmse_truth"]) < 1e-3, (mixed["PF"], fp64["PF"])
-assert mixed["PF"]["rmse_truth"] != fp64["PF"]["rmse_truth"], "mixed gave fp64's bits"
+coarse, fine = (json.load(open(p))["filters"] for p in sys.argv[1:3])
+assert coarse["PF"]["estimator"]["precision"] == sys.argv[3], coarse["PF"]
+assert coarse["EXACT"]["rmse_ref"] < 0.05, coarse["EXACT"]
+assert abs(coarse["PF"]["rmse_truth"] - fine["PF"]["rmse_truth"]) < 1e-3, (coarse["PF"], fine["PF"])
+assert coarse["PF"]["rmse_truth"] != fine["PF"]["rmse_truth"], "the same bits as the finer precision"
 PY
-echo "ok: --precision mixed"
+  echo "ok: --precision $precision"
+  finer=$precision
+done
 # Step pairs (the bank scoring one step behind so that PF takes two steps per call): on the host the two steps
 # run one after the other, so `always` must give every number of `never` bit for bit, with an odd step count and
 # output times that make some steps single (a GPU's fused pass: the same numbers to 1e-10).
@@ -138,8 +144,7 @@ expect_refused() {  # expect_refused "message fragment" args...: one line, exit 
 expect_refused "--particles: must be at least 1 (got 0)" compare --particles 0
 expect_refused "--resample: unknown scheme 'best'" compare --resample best
 expect_refused "--ess-threshold: must be in [0, 1] (got 1.5)" compare --ess-threshold 1.5
-expect_refused "--precision: unknown precision 'half' (known: fp64, mixed)" compare --precision half
-expect_refused "--precision fp32: not available" compare --precision fp32
+expect_refused "--precision: unknown precision 'half' (known: fp64, mixed, fp32)" compare --precision half
 expect_refused "--step-pairs: unknown value 'sometimes' (known: auto, always, never)" compare --step-pairs sometimes
 expect_refused "--trajectory-members: member 99 is not in 0 .. 9" compare --members 10 --trajectory-members 99
 expect_refused "--density-times: 20 is not in [0, T = 10]" compare --density-times 20

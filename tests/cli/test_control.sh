@@ -89,6 +89,7 @@ bad twice "LQR@state is named twice" --controllers LQR@state,LQR@state
 bad uncontrolled "has no control input" --model ou
 bad trace "--trace-member: member 10 is not in 0 .. 9" --trace-member 10
 bad reference_direct "--reference direct: the problem is stochastic" --reference direct
+bad fp32 "--precision fp32: not available in control" --controllers LQR@PF --precision fp32
 run_kushner "$work/bad" control --model terpolymer --controllers HJB@state --out "$work/hjb10"
 [ "$rc" -eq 2 ] && [ ! -e "$work/hjb10" ] || fail "HJB on a 10-state model was not refused: $(cat "$work/bad.err")"
 
