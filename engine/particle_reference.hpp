@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <type_traits>
 #include <vector>
 
 namespace kushner {
@@ -165,9 +166,11 @@ class ParticleReference<ExecSpace, NotShared<Model>, Real> {};
 template <class ExecSpace, class Model>
 std::unique_ptr<ReferenceEstimator<typename ExecSpace::memory_space>> make_particle_reference(
     const ExecSpace& space, const Model& model, long members, Seed seed, const ParticleSettings& settings) {
-  if (settings.options.precision == ParticlePrecision::fp32)
-    return std::make_unique<ParticleReference<ExecSpace, Model, float>>(space, model, members, seed, settings);
-  return std::make_unique<ParticleReference<ExecSpace, Model>>(space, model, members, seed, settings);
+  return with_particle_storage(settings.options.precision, [&](auto* stored) {
+    using Real = std::remove_pointer_t<decltype(stored)>;
+    return std::unique_ptr<ReferenceEstimator<typename ExecSpace::memory_space>>(
+        std::make_unique<ParticleReference<ExecSpace, Model, Real>>(space, model, members, seed, settings));
+  });
 }
 
 #define KUSHNER_SHARED_INSTANCE(Space, Model)                                   \

@@ -7,6 +7,8 @@
 
 #include <Kokkos_Core.hpp>
 
+#include <limits>
+
 namespace kushner {
 
 /// (member, i): states, estimates, observation increments.
@@ -30,6 +32,15 @@ using ParticleBank = Kokkos::View<Real***, Kokkos::LayoutLeft, MemSpace>;
 /// (particle, member): one number per particle (log-weights), stored as Real.
 template <class MemSpace, class Real = double>
 using ParticleColumn = Kokkos::View<Real**, Kokkos::LayoutLeft, MemSpace>;
+
+/// `v` as it is stored in a Real: rounded to float in the particle filter's fp32 precision, so that what a kernel
+/// keeps in registers (and sums into moments, or steps again in a fused pair) is what it stores.
+template <class Real>
+KOKKOS_INLINE_FUNCTION double stored_value(double v) {
+  // IEEE 754 conversion: to nearest, and past float's range to the infinity of the value's sign.
+  static_assert(std::numeric_limits<Real>::is_iec559, "particles are stored in IEEE 754 numbers");
+  return static_cast<double>(static_cast<Real>(v));
+}
 
 /// (member): one scalar per member (status, counts, log-normalizers).
 template <class T, class MemSpace>

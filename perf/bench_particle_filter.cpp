@@ -10,6 +10,7 @@
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <type_traits>
 
 namespace kushner {
 namespace {
@@ -83,10 +84,9 @@ void BM_ParticleFilterStep(benchmark::State& state) {
   if (state.range(2) > 0) options.particles_per_thread = static_cast<int>(state.range(2));
   if (state.range(5) == 1) options.precision = ParticlePrecision::mixed;
   if (state.range(5) == 2) options.precision = ParticlePrecision::fp32;
-  if (options.precision == ParticlePrecision::fp32)
-    particle_filter_steps<Model, float>(state, options);
-  else
-    particle_filter_steps<Model, double>(state, options);
+  with_particle_storage(options.precision, [&](auto* stored) {
+    particle_filter_steps<Model, std::remove_pointer_t<decltype(stored)>>(state, options);
+  });
 }
 
 /// The physical floor: a deep_copy of the bytes one step moves (half read, half written).

@@ -171,9 +171,10 @@ template <class Space>
 std::vector<double> run_sine(int members, int particles, int steps, ParticleFilterOptions options,
                              std::vector<double>* covariance = nullptr, std::vector<double>* ess = nullptr,
                              bool pairs = false) {
-  if (options.precision == ParticlePrecision::fp32)
-    return run_sine_stored<Space, float>(members, particles, steps, options, covariance, ess, pairs);
-  return run_sine_stored<Space>(members, particles, steps, options, covariance, ess, pairs);
+  return with_particle_storage(options.precision, [&](auto* stored) {
+    using Real = std::remove_pointer_t<decltype(stored)>;
+    return run_sine_stored<Space, Real>(members, particles, steps, options, covariance, ess, pairs);
+  });
 }
 
 TEST(ParticleFilterBank, TeamKernelAgreesWithHostBlockKernel) {

@@ -15,6 +15,7 @@
 
 #include <iostream>
 #include <string>
+#include <type_traits>
 
 namespace kushner {
 namespace {
@@ -43,13 +44,11 @@ Convergence converge(const Model& model, ParticlePrecision precision, const std:
   std::vector<double> wrong_rms;
   test::Trajectory largest;
   for (double n : particle_counts) {
-    if (precision == ParticlePrecision::fp32) {
-      ParticleFilterBank<Space, Model, float> pf(Space(), model, members, static_cast<int>(n), 4321, options);
-      largest = test::replay(pf, dys, dt);
-    } else {
-      ParticleFilterBank<Space, Model> pf(Space(), model, members, static_cast<int>(n), 4321, options);
-      largest = test::replay(pf, dys, dt);
-    }
+    largest = with_particle_storage(precision, [&](auto* stored) {
+      using Real = std::remove_pointer_t<decltype(stored)>;
+      ParticleFilterBank<Space, Model, Real> pf(Space(), model, members, static_cast<int>(n), 4321, options);
+      return test::replay(pf, dys, dt);
+    });
     c.rms.push_back(test::rms_distance(largest, exact));
     wrong_rms.push_back(test::rms_distance(largest, wrong));
   }

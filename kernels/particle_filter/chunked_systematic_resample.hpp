@@ -91,8 +91,7 @@ KOKKOS_INLINE_FUNCTION void load_weights(const Team& team, const Data& d, int me
     double l[resample_batch];
     for (int k = 0; k < resample_batch; ++k) l[k] = j0 + k * stride < end ? d.log_weight(j0 + k * stride, member) : 0.0;
     for (int k = 0; k < resample_batch; ++k)
-      if (j0 + k * stride < end)
-        w(j0 + k * stride - begin) = static_cast<double>(static_cast<Real>(math::exp(l[k] - log_total)));
+      if (j0 + k * stride < end) w(j0 + k * stride - begin) = stored_value<Real>(math::exp(l[k] - log_total));
   });
   team.team_barrier();
 }

@@ -26,6 +26,14 @@ inline const char* to_string(ParticlePrecision p) {
   return "unknown";
 }
 
+/// f(static_cast<Real*>(nullptr)), with Real the type `precision` stores particles in: float for fp32, double
+/// otherwise. Picks ParticleFilterBank's storage type from a run-time precision (f's two results must agree).
+template <class F>
+decltype(auto) with_particle_storage(ParticlePrecision precision, F&& f) {
+  if (precision == ParticlePrecision::fp32) return f(static_cast<float*>(nullptr));
+  return f(static_cast<double*>(nullptr));
+}
+
 /// The precision called `name`, if there is one.
 inline std::optional<ParticlePrecision> particle_precision_named(const std::string& name) {
   for (auto p : {ParticlePrecision::fp64, ParticlePrecision::mixed, ParticlePrecision::fp32})

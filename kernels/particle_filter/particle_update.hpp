@@ -22,7 +22,6 @@
 #include <Kokkos_Core.hpp>
 
 #include <cstdint>
-#include <limits>
 #include <type_traits>
 
 namespace kushner {
@@ -121,33 +120,21 @@ KOKKOS_INLINE_FUNCTION typename Model::Control particle_control(const ParticleSt
   return Model::Control::zero();
 }
 
-/// `v` as it is stored in a Real: rounded to float in the fp32 precision, so that what a kernel keeps in registers
-/// (and sums into moments, or steps again in a fused pair) is what it stores.
-template <class Real>
-KOKKOS_INLINE_FUNCTION double stored_value(double v) {
-  // IEEE 754 conversion: to nearest, and past float's range to the infinity of the value's sign.
-  static_assert(std::numeric_limits<Real>::is_iec559, "particles are stored in IEEE 754 numbers");
-  return static_cast<double>(static_cast<Real>(v));
-}
-template <class Real, int N>
-KOKKOS_INLINE_FUNCTION Vec<N> stored_value(Vec<N> v) {
-  KUSHNER_UNROLL_FULLY
-  for (int i = 0; i < N; ++i) v[i] = stored_value<Real>(v[i]);
-  return v;
-}
-
-/// A particle's new state x and log-weight l as the bank stores them (stored_value); returns l, or -inf where x
-/// left float's range (stored as inf: the particle has left the numbers). Nothing to do for double. The host's
-/// block kernel applies the same rule in loops of its own (particle_block_step.hpp: GCC vectorizes those).
+/// A particle's new state x and log-weight l as the bank stores them (stored_value, kernels/bank.hpp); returns l, or
+/// -inf where x left float's range (stored as inf: the particle has left the numbers). Nothing to do for double.
+/// The host's block kernel applies the same rule in loops of its own (particle_block_step.hpp: GCC vectorizes
+/// those).
 template <class Real, int N>
 KOKKOS_INLINE_FUNCTION double round_to_storage(Vec<N>& x, double l) {
   if constexpr (std::is_same_v<Real, double>) {
     return l;
   } else {
-    x = stored_value<Real>(x);
     bool finite = true;
     KUSHNER_UNROLL_FULLY
-    for (int i = 0; i < N; ++i) finite = finite & math::is_finite(x[i]);
+    for (int i = 0; i < N; ++i) {
+      x[i] = stored_value<Real>(x[i]);
+      finite = finite & math::is_finite(x[i]);
+    }
     return finite ? stored_value<Real>(l) : -math::infinity();
   }
 }
