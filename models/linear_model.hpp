@@ -56,14 +56,24 @@ struct LinearModel : InitialLaw<N> {
     this->initial_law_parameters(v);
   }
 
-  KOKKOS_INLINE_FUNCTION Vec<N> drift(double, const Vec<N>& x, const Control& u) const { return a0 + A * x + B * u; }
+  // Templates on the scalar: the particle filter's fp32 steps its particles in float (particle_model_traits.hpp).
+  template <class T>
+  KOKKOS_INLINE_FUNCTION Vec<N, T> drift(double, const Vec<N, T>& x, const Control& u) const {
+    return convert<T>(a0) + convert<T>(A) * x + convert<T>(B * u);
+  }
   KOKKOS_INLINE_FUNCTION Mat<N, 1> control_input(double) const { return B; }
   KOKKOS_INLINE_FUNCTION Mat<N, N> drift_jacobian(double, const Vec<N>&, const Control&) const { return A; }
   KOKKOS_INLINE_FUNCTION Mat<N, N> drift_hessian(double, const Vec<N>&, const Control&, int) const {
     return Mat<N, N>::zero();
   }
-  KOKKOS_INLINE_FUNCTION Mat<N, N> diffusion(double, const Vec<N>&) const { return b; }
-  KOKKOS_INLINE_FUNCTION Vec<N> observation(double, const Vec<N>& x) const { return c0 + C * x; }
+  template <class T>
+  KOKKOS_INLINE_FUNCTION Mat<N, N, T> diffusion(double, const Vec<N, T>&) const {
+    return convert<T>(b);
+  }
+  template <class T>
+  KOKKOS_INLINE_FUNCTION Vec<N, T> observation(double, const Vec<N, T>& x) const {
+    return convert<T>(c0) + convert<T>(C) * x;
+  }
   KOKKOS_INLINE_FUNCTION Mat<N, N> observation_jacobian(double, const Vec<N>&) const { return C; }
   KOKKOS_INLINE_FUNCTION Mat<N, N> observation_hessian(double, const Vec<N>&, int) const { return Mat<N, N>::zero(); }
   KOKKOS_INLINE_FUNCTION Mat<N, N> observation_noise(double) const { return R; }

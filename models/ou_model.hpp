@@ -32,13 +32,21 @@ struct OuModel : InitialLaw<1> {
     initial_law_parameters(v);
   }
 
-  KOKKOS_INLINE_FUNCTION Vec<1> drift(double, const Vec<1>& x, const Control&) const {
-    return {{-theta * (x[0] - mu)}};
+  // Templates on the scalar: the particle filter's fp32 steps its particles in float (particle_model_traits.hpp).
+  template <class T>
+  KOKKOS_INLINE_FUNCTION Vec<1, T> drift(double, const Vec<1, T>& x, const Control&) const {
+    return {{-static_cast<T>(theta) * (x[0] - static_cast<T>(mu))}};
   }
   KOKKOS_INLINE_FUNCTION Mat<1, 1> drift_jacobian(double, const Vec<1>&, const Control&) const { return {{{-theta}}}; }
   KOKKOS_INLINE_FUNCTION Mat<1, 1> drift_hessian(double, const Vec<1>&, const Control&, int) const { return {{{0.0}}}; }
-  KOKKOS_INLINE_FUNCTION Mat<1, 1> diffusion(double, const Vec<1>&) const { return {{{sigma}}}; }
-  KOKKOS_INLINE_FUNCTION Vec<1> observation(double, const Vec<1>& x) const { return x; }
+  template <class T>
+  KOKKOS_INLINE_FUNCTION Mat<1, 1, T> diffusion(double, const Vec<1, T>&) const {
+    return {{{static_cast<T>(sigma)}}};
+  }
+  template <class T>
+  KOKKOS_INLINE_FUNCTION Vec<1, T> observation(double, const Vec<1, T>& x) const {
+    return x;
+  }
   KOKKOS_INLINE_FUNCTION Mat<1, 1> observation_jacobian(double, const Vec<1>&) const { return {{{1.0}}}; }
   KOKKOS_INLINE_FUNCTION Mat<1, 1> observation_hessian(double, const Vec<1>&, int) const { return {{{0.0}}}; }
   KOKKOS_INLINE_FUNCTION Mat<1, 1> observation_noise(double) const { return {{{r}}}; }

@@ -31,8 +31,10 @@ struct SineModel : InitialLaw<1> {
     initial_law_parameters(v);
   }
 
-  KOKKOS_INLINE_FUNCTION Vec<1> drift(double, const Vec<1>& x, const Control& u) const {
-    return {{-math::sin(x[0]) + B(0, 0) * u[0]}};
+  // Templates on the scalar: the particle filter's fp32 steps its particles in float (particle_model_traits.hpp).
+  template <class T>
+  KOKKOS_INLINE_FUNCTION Vec<1, T> drift(double, const Vec<1, T>& x, const Control& u) const {
+    return {{-math::sin(x[0]) + static_cast<T>(B(0, 0) * u[0])}};
   }
   KOKKOS_INLINE_FUNCTION Mat<1, 1> control_input(double) const { return B; }
   KOKKOS_INLINE_FUNCTION Mat<1, 1> drift_jacobian(double, const Vec<1>& x, const Control&) const {
@@ -41,8 +43,14 @@ struct SineModel : InitialLaw<1> {
   KOKKOS_INLINE_FUNCTION Mat<1, 1> drift_hessian(double, const Vec<1>& x, const Control&, int) const {
     return {{{math::sin(x[0])}}};
   }
-  KOKKOS_INLINE_FUNCTION Mat<1, 1> diffusion(double, const Vec<1>&) const { return {{{q}}}; }
-  KOKKOS_INLINE_FUNCTION Vec<1> observation(double, const Vec<1>& x) const { return x; }
+  template <class T>
+  KOKKOS_INLINE_FUNCTION Mat<1, 1, T> diffusion(double, const Vec<1, T>&) const {
+    return {{{static_cast<T>(q)}}};
+  }
+  template <class T>
+  KOKKOS_INLINE_FUNCTION Vec<1, T> observation(double, const Vec<1, T>& x) const {
+    return x;
+  }
   KOKKOS_INLINE_FUNCTION Mat<1, 1> observation_jacobian(double, const Vec<1>&) const { return {{{1.0}}}; }
   KOKKOS_INLINE_FUNCTION Mat<1, 1> observation_hessian(double, const Vec<1>&, int) const { return {{{0.0}}}; }
   KOKKOS_INLINE_FUNCTION Mat<1, 1> observation_noise(double) const { return {{{r}}}; }

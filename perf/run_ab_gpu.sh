@@ -7,7 +7,9 @@
 # benchmark at M = 1000, N = 65536 in alternating rounds (old, new, new with Kokkos' team_reduce, ...) in the
 # same call, and prints each variant's median rate and its ratio to the old one.
 #   AB_PHASES="build check bench" OUT=<dir> perf/run_ab_gpu.sh .baseline
-# Environment: KUSHNER_JOBS (16), KUSHNER_CUDA_ARCH (AMPERE80), AB_ROUNDS (4), AB_REPETITIONS (3 per round).
+# Environment: KUSHNER_JOBS (16), KUSHNER_CUDA_ARCH (AMPERE80), AB_ROUNDS (4), AB_REPETITIONS (3 per round),
+# KUSHNER_CMAKE_ARGS (added to both configures: e.g. -DKUSHNER_SHARED_INSTANCES=OFF, which builds only what the
+# targets use), AB_NEW_TARGETS (the new tree's targets; default below).
 set -uo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 old_src=$(cd "${1:?usage: run_ab_gpu.sh <baseline source tree>}" && pwd)
@@ -34,8 +36,9 @@ build_tree() {  # build_tree SRC BUILD TARGETS...
   local src=$1 dir=$2; shift 2
   local name; name=$(basename "$dir")
   cmake -S "$src" -B "$dir" -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON -DKUSHNER_ENABLE_OPENMP=OFF \
-    -DKUSHNER_CUDA_ARCH="$arch" > "$out/configure_$name.log" 2>&1 || return 1
-  cmake --build "$dir" -j"$jobs" --target kushner_test_main kushner_bench_main > "$out/build_$name.log" 2>&1 || return 1
+    -DKUSHNER_CUDA_ARCH="$arch" ${KUSHNER_CMAKE_ARGS:-} > "$out/configure_$name.log" 2>&1 || return 1
+  cmake --build "$dir" -j"$jobs" --target kushner_engine kushner_test_main kushner_bench_main > "$out/build_$name.log" 2>&1 ||
+    return 1
   local pids=() t rc=0
   for t in "$@"; do
     cmake --build "$dir" -j2 --target "$t" > "$out/build_${name}_$t.log" 2>&1 &
@@ -49,8 +52,10 @@ if want build; then
   log "build old ($old_src) and new, at once"
   build_tree "$old_src" "$old_build" particle_filter_dump bench_particle_filter &
   old_pid=$!
-  build_tree "$here" "$new_build" particle_filter_dump bench_particle_filter bench_particle_filter_kokkos_team_sum \
-    test_particle_filter test_resampling test_particle_filter_references || { status=1; echo "new build failed"; }
+  # shellcheck disable=SC2086
+  build_tree "$here" "$new_build" ${AB_NEW_TARGETS:-particle_filter_dump bench_particle_filter \
+    bench_particle_filter_kokkos_team_sum test_particle_filter test_resampling test_particle_filter_references} ||
+    { status=1; echo "new build failed"; }
   wait $old_pid || { status=1; echo "old build failed"; }
   grep -h -B2 -A8 "error" "$out"/build_*.log | head -60
   log "built"

@@ -19,4 +19,30 @@ struct has_exact_transition<Model, std::void_t<decltype(std::declval<const Model
                                        0.0, std::declval<const Vec<Model::state_dim>&>(), 0.0,
                                        std::declval<const Vec<Model::noise_dim>&>(), 0.0))>> : std::true_type {};
 
+/// A model whose drift, diffusion and observation are templates on the scalar (sine_model.hpp) can be evaluated in
+/// float: the particle filter's fp32 then steps its particles in float, which costs a GPU a fraction of the energy
+/// of fp64 sin, exp and multiply-adds (perf/particle_filter.md).
+template <class Model, class = void>
+struct has_float_dynamics : std::false_type {};
+template <class Model>
+struct has_float_dynamics<
+    Model, std::enable_if_t<std::is_same_v<decltype(std::declval<const Model&>().drift(
+                                               0.0, std::declval<const Vec<Model::state_dim, float>&>(),
+                                               std::declval<const typename Model::Control&>())),
+                                           Vec<Model::state_dim, float>> &&
+                            std::is_same_v<decltype(std::declval<const Model&>().diffusion(
+                                               0.0, std::declval<const Vec<Model::state_dim, float>&>())),
+                                           Mat<Model::state_dim, Model::noise_dim, float>> &&
+                            std::is_same_v<decltype(std::declval<const Model&>().observation(
+                                               0.0, std::declval<const Vec<Model::state_dim, float>&>())),
+                                           Vec<Model::obs_dim, float>>>> : std::true_type {};
+
+/// The scalar a particle's Euler-Maruyama step is computed in, for particles stored as Real: float where they are
+/// stored in float and the model's dynamics take float, else double (as are exact and discrete-time transitions).
+template <class Model, class Real>
+using particle_step_scalar =
+    std::conditional_t<std::is_same_v<Real, float> && !Model::discrete_time && !has_exact_transition<Model>::value &&
+                           has_float_dynamics<Model>::value,
+                       float, double>;
+
 }  // namespace kushner

@@ -11,10 +11,11 @@ namespace kushner {
 /// bound by the card's power cap: perf/particle_filter.md). The normals agree with fp64's to about 1e-7 and are cut
 /// at 5.77 standard deviations of the radius (probability 2^-24 beyond). fp32: mixed's normals, and the particles
 /// and their log-weights (and, while resampling, cumulative weights) stored in float: half the bytes moved per
-/// particle-step, and about half the memory per particle (the ancestor index stays an int); each particle's step is
-/// computed in double from the stored values and rounded once where it is stored, and the normalizers, moments and
-/// every sum are taken in double. tests/test_particle_filter_references.cpp checks every precision for bias against
-/// exact filters.
+/// particle-step, and about half the memory per particle (the ancestor index stays an int). A particle's
+/// Euler-Maruyama step is computed in float where the model's dynamics take float (particle_step_scalar), otherwise
+/// in double from the stored values, and rounded once where it is stored; the GPU kernels take the weights' exp in
+/// float; the normalizers, moments and every sum are taken in double. tests/test_particle_filter_references.cpp
+/// checks every precision for bias against exact filters.
 enum class ParticlePrecision { fp64, mixed, fp32 };
 
 inline const char* to_string(ParticlePrecision p) {

@@ -11,12 +11,17 @@
 
 #include <Kokkos_Core.hpp>
 
+#include <type_traits>
+
 namespace kushner {
 
 /// Where the team's sums are too far from their shift (particles far from the observation, an extreme dy)
 /// they could under- or overflow. Within 200 of the shift a square is at most e^400 ~ 5e173, so sums of
-/// squares of any int-counted number of particles stay finite.
-constexpr double team_max_shift_gap = 200.0;
+/// squares of any int-counted number of particles stay finite. With Real = float (fp32) the exp is taken in float
+/// (add_shifted_particle), whose normal numbers span e^-87 .. e^88: within 60 of the shift, every particle within
+/// e^-27 of the largest weight is a normal float.
+template <class Real>
+constexpr double team_max_shift_gap = std::is_same_v<Real, float> ? 60.0 : 200.0;
 
 /// Particle pairs per batch of a thread.
 constexpr int device_pairs_per_batch = (device_particle_batch + 1) / 2;
@@ -65,10 +70,11 @@ KOKKOS_INLINE_FUNCTION void draw_particle_batch(const RngKey& key, int member, i
                                           u[2 * b + 1]);
 }
 
-/// Adds a particle of log-weight l - shift; weight zero adds nothing (its x may not be finite).
-template <int N>
+/// Adds a particle of log-weight l - shift; weight zero adds nothing (its x may not be finite). Its weight's exp
+/// is taken in Real (float for fp32: a GPU's fp64 exp costs several times the energy), the sums in double.
+template <class Real, int N>
 KOKKOS_INLINE_FUNCTION void add_shifted_particle(double shifted, const Vec<N>& dx, WeightedMoments<N>& w) {
-  const double e = math::exp(shifted);
+  const double e = math::exp(static_cast<Real>(shifted));
   if (e > 0.0) w.add_weight(e, dx);
 }
 
@@ -76,13 +82,13 @@ KOKKOS_INLINE_FUNCTION void add_shifted_particle(double shifted, const Vec<N>& d
 /// largest l. Afterwards every thread holds the team's sums relative to the returned shift in w. Where the
 /// team's largest l is more than team_max_shift_gap from `shift` (rare, and the same for the whole team), the
 /// team sums again relative to its largest l: resum(shift, w) adds the thread's particles to an empty w.
-template <int N, class Team, class Scratch, class Resum>
+template <class Real, int N, class Team, class Scratch, class Resum>
 KOKKOS_INLINE_FUNCTION void team_moments_at_shift(const Team& team, const Scratch& buffer, double shift,
                                                   WeightedMoments<N>& w, const Resum& resum) {
   team_sum(team, buffer, w);
   if (!(w.max_log_weight > -math::infinity())) return;  // every particle of the chunk has weight zero
   const double gap = w.max_log_weight - shift;
-  if (!(gap >= -team_max_shift_gap && gap <= team_max_shift_gap)) {
+  if (!(gap >= -team_max_shift_gap<Real> && gap <= team_max_shift_gap<Real>)) {
     shift = w.max_log_weight;
     w = WeightedMoments<N>::empty();
     resum(shift, w);

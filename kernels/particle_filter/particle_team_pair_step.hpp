@@ -45,12 +45,13 @@ struct ParticleTeamPairStep {
       step_particles(member, c, ref, vinv_dy, shift, w);
     }
     // Step k's resum recomputes it from the pass's inputs; step k + 1's reads the values just stored.
-    team_moments_at_shift(team, buffer, shift[0], w[0],
-                          [&](double s, WeightedMoments<n>& v) { resum_first_step(member, c, ref, vinv_dy[0], s, v); });
+    team_moments_at_shift<Real>(team, buffer, shift[0], w[0], [&](double s, WeightedMoments<n>& v) {
+      resum_first_step(member, c, ref, vinv_dy[0], s, v);
+    });
     if (c.rank == 0) w[0].store(d.partials, chunk, member);
-    team_moments_at_shift(team, buffer, shift[1], w[1], [&](double s, WeightedMoments<n>& v) {
+    team_moments_at_shift<Real>(team, buffer, shift[1], w[1], [&](double s, WeightedMoments<n>& v) {
       for (int j = c.begin + c.rank; j < c.end; j += c.threads)
-        add_shifted_particle(next.log_weight(j, member) - s, load_particle<n>(next.x, j, member) - ref, v);
+        add_shifted_particle<Real>(next.log_weight(j, member) - s, load_particle<n>(next.x, j, member) - ref, v);
     });
     if (c.rank == 0) w[1].store(next.partials, chunk, member);
   }
@@ -97,7 +98,7 @@ struct ParticleTeamPairStep {
           }
           lw[k] = l;
           top[s] = l > top[s] ? l : top[s];
-          add_shifted_particle(l - shift[s], x[k] - ref, w[s]);
+          add_shifted_particle<Real>(l - shift[s], x[k] - ref, w[s]);
         }
       }
     }
@@ -121,7 +122,7 @@ struct ParticleTeamPairStep {
         Vec<n> x = load_particle<n>(d.x, j, member);
         const double l = update_particle<false>(d, d.t, d.observation_precision, z[k], u[k], d.log_weight(j, member),
                                                 log_normalizer, vinv_dy, uncontrolled(), x);
-        add_shifted_particle(l - shift, x - ref, w);
+        add_shifted_particle<Real>(l - shift, x - ref, w);
       }
     }
   }

@@ -35,9 +35,9 @@ struct ParticleTeamStep {
         step_particles<false>(member, c, ref, vinv_dy, shift, w);
       }
     }
-    team_moments_at_shift(team, buffer, shift, w, [&](double s, WeightedMoments<n>& v) {
+    team_moments_at_shift<Real>(team, buffer, shift, w, [&](double s, WeightedMoments<n>& v) {
       for (int j = c.begin + c.rank; j < c.end; j += c.threads)
-        add_shifted_particle(d.log_weight(j, member) - s, load_particle<n>(d.x, j, member) - ref, v);
+        add_shifted_particle<Real>(d.log_weight(j, member) - s, load_particle<n>(d.x, j, member) - ref, v);
     });
     if (c.rank == 0) w.store(d.partials, chunk, member);
   }
@@ -76,7 +76,7 @@ struct ParticleTeamStep {
         for (int i = 0; i < n; ++i) xm[j + i * stride] = static_cast<Real>(x[k][i]);
         lwm[j] = static_cast<Real>(l);
         top = l > top ? l : top;
-        add_shifted_particle(l - shift, x[k] - ref, w);
+        add_shifted_particle<Real>(l - shift, x[k] - ref, w);
       }
     }
     w.max_log_weight = top;

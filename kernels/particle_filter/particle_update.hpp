@@ -28,7 +28,7 @@ namespace kushner {
 
 /// Everything one step reads and writes. Views are (particle, member[, i]) or (member[, i]), LayoutLeft. The
 /// particles and log-weights are stored as Real (float in the fp32 precision: particle_precision.hpp); a particle's
-/// step computes in double.
+/// step computes in particle_step_scalar<Model, Real>.
 template <class Model, class MemSpace, class Real = double>
 struct ParticleStepData {
   static constexpr int n = Model::state_dim, p = Model::obs_dim, q = Model::noise_dim;
@@ -159,14 +159,20 @@ KOKKOS_INLINE_FUNCTION double update_particle_unrounded(
     for (int i = 0; i < n; ++i) finite = finite & math::is_finite(x[i]);
     return finite ? l : -math::infinity();
   } else {
+    // In S: float where fp32 stores floats and the model's dynamics take float (particle_step_scalar), else double
+    // (every convert<double> below is then a copy, and the expressions are those of the double step).
+    using S = particle_step_scalar<Model, Real>;
+    Vec<n, S> xs = convert<S>(x);
     if constexpr (has_exact_transition<Model>::value) {
-      x = d.model.sample_exact_transition(t, x, d.dt, z, u);
+      xs = d.model.sample_exact_transition(t, xs, d.dt, z, u);
     } else {
-      x = x + d.model.drift(t, x, control) * d.dt + d.model.diffusion(t, x) * (z * d.sqrt_dt);
+      xs = xs + d.model.drift(t, xs, control) * static_cast<S>(d.dt) +
+           d.model.diffusion(t, xs) * (convert<S>(z) * static_cast<S>(d.sqrt_dt));
     }
-    const Vec<p> h = d.model.observation(t + d.dt, x);
-    const double increment = dot(h, vinv_dy) - 0.5 * d.dt * dot(h, precision * h);
-    const double l = log_weight - log_normalizer + increment;
+    const Vec<p, S> h = d.model.observation(t + d.dt, xs);
+    const S increment = dot(h, convert<S>(vinv_dy)) - static_cast<S>(0.5 * d.dt) * dot(h, convert<S>(precision) * h);
+    const double l = static_cast<S>(log_weight - log_normalizer) + increment;
+    x = convert<double>(xs);
     bool finite = math::is_finite(l);
     KUSHNER_UNROLL_FULLY
     for (int i = 0; i < n; ++i) finite = finite & math::is_finite(x[i]);  // `&`: no branch, so GCC can vectorize
@@ -178,8 +184,8 @@ KOKKOS_INLINE_FUNCTION double update_particle_unrounded(
 /// Moves one particle (x in, x out) over [t, t + dt] with its draws (normals z, uniform u) and returns its new
 /// log-weight, normalized by the member's previous log-normalizer; -inf for a particle that left the finite
 /// numbers. `precision` is V^{-1} at t; `control` is the member's (particle_control). A discrete-time model's
-/// precision is the identity, so `vinv_dy` is z[k+1] itself. The step computes in double; x and the log-weight
-/// come out as the bank stores them (stored_value).
+/// precision is the identity, so `vinv_dy` is z[k+1] itself. The step computes in particle_step_scalar (float only
+/// for fp32 and a model with float dynamics); x and the log-weight come out as the bank stores them (stored_value).
 template <bool Initialize, class Model, class MemSpace, class Real>
 KOKKOS_INLINE_FUNCTION double update_particle(const ParticleStepData<Model, MemSpace, Real>& d, double t,
                                               const Mat<Model::obs_dim, Model::obs_dim>& precision,
