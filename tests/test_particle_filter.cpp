@@ -250,6 +250,58 @@ TEST(ParticleFilterBank, TeamKernelResumsWhenTheWeightBoundIsFarOff) {
   }
 }
 
+TEST(ParticleFilterBank, Fp32TeamKernelResumsWhereFloatExpUnderflows) {
+  // Under fp32 the team kernel takes exp(l - s) in float, whose normal numbers end near e^-87. A dy that puts the
+  // bound s about 100 nats above every particle's l (inside fp64's 200-nat gap, past float's range) must make the
+  // team sum again relative to its largest l, and give the host kernel's posterior (block maxima, exp in double):
+  // the same particles up to a float's last bits, so to 1e-5. Also for step_pair, the outlier in each of its steps.
+  SineModel model;
+  const int members = 3, particles = 3000;
+  ParticleFilterOptions block, team;
+  block.kernel = ParticleKernel::host_block;
+  team.kernel = ParticleKernel::team;
+  block.precision = team.precision = ParticlePrecision::fp32;
+  block.ess_threshold = team.ess_threshold = 0.0;
+  using Bank = ParticleFilterBank<Host, SineModel, float>;
+  Bank pb(Host(), model, members, particles, seed, block);
+  Bank pt(Host(), model, members, particles, seed, team);
+  Bank pp(Host(), model, members, particles, seed, team);
+  std::vector<BankVector<Kokkos::HostSpace>> dy;
+  for (int k = 0; k < 5; ++k) {
+    dy.emplace_back("dy", members, 1);
+    dy[k](0, 0) = 0.01;
+    dy[k](1, 0) = k == 1 || k == 4 ? 0.7 : 0.01;  // s = 0.7^2 / (2 r^2 dt) = 98 nats
+    dy[k](2, 0) = -0.02;
+  }
+  auto expect_agree = [&](const Bank& p, const char* which, int k) {
+    Host().fence();
+    for (int m = 0; m < members; ++m) {
+      ASSERT_EQ(p.status()(m), Status::ok) << which << " step " << k << " member " << m;
+      const double mean = pb.posterior_mean()(m, 0), cov = pb.posterior_covariance()(m, 0);
+      EXPECT_NEAR(p.posterior_mean()(m, 0), mean, 1e-5 * (1 + std::abs(mean)))
+          << which << " step " << k << " member " << m;
+      EXPECT_NEAR(p.posterior_covariance()(m, 0), cov, 1e-5 * cov) << which << " step " << k << " member " << m;
+    }
+  };
+  for (int k = 0; k < 5; ++k) {
+    pb.step(k, 0.01, dy[k]);
+    pt.step(k, 0.01, dy[k]);
+    if (k == 0) pp.step(k, 0.01, dy[k]);
+    if (k == 2 || k == 4) pp.step_pair(k - 1, 0.01, dy[k - 1], dy[k]);
+    if (k == 1) {  // the largest l of the outlier member lies between float's range and fp64's 200 nats below s
+      Host().fence();
+      double top = -math::infinity();
+      for (int j = 0; j < particles; ++j) top = std::max(top, double(pb.log_weights()(j, 1)));
+      const double gap = 0.5 * 0.7 * 0.7 / (model.r * model.r * 0.01) - top;  // stored l: already normalized
+      std::cout << "outlier: largest log-weight " << gap << " nats below the bound\n";
+      EXPECT_GT(gap, 90.0);
+      EXPECT_LT(gap, 200.0);
+    }
+    expect_agree(pt, "step", k);
+    if (k % 2 == 0) expect_agree(pp, "step_pair", k);
+  }
+}
+
 /// Posterior mean, covariance and ESS of every member, and the resampling counts.
 struct PosteriorCopy {
   std::vector<double> mean, covariance, ess;
