@@ -1,9 +1,11 @@
 // The structured forms each model hands the filters describe the same drift as drift() itself: linear
 // forms, componentwise and bilinear polynomials, SDC factorizations A(x) x + b and C(x) x + c0, linear
 // observations, and the closed-form Gaussian expectations of drift and observation (seed 000 (6.4)-(6.5), (6.14);
-// polynomial moments; the cubic sensor's and pendulum's E[h]) against 20-node Gauss-Hermite cubature. Every
-// continuous-time model of the registry is checked for every form it has.
+// polynomial moments; the cubic sensor's and pendulum's E[h]) against 20-node Gauss-Hermite cubature, and the
+// float dynamics of a model that has them (fp32's particle step) against its double ones. Every continuous-time
+// model of the registry is checked for every form it has.
 #include "kernels/filters/gaussian_expectations.hpp"
+#include "kernels/particle_filter/particle_model_traits.hpp"
 #include "models/registry.hpp"
 
 #include <gtest/gtest.h>
@@ -80,6 +82,19 @@ void expect_forms_match_drift(const Model& model) {
                 << name << " E[grad h] (" << i << ", " << j << ")";
       }
     }
+    if constexpr (has_float_dynamics<Model>::value) {  // the same functions, to float's precision
+      const Vec<n, float> xf = convert<float>(x);
+      const Vec<n> x_rounded = convert<double>(xf);
+      expect_vectors_near(convert<double>(model.drift(t, xf, u)), model.drift(t, x_rounded, u), 1e-6,
+                          name + " float drift");
+      expect_vectors_near(convert<double>(model.observation(t, xf)), model.observation(t, x_rounded), 1e-6,
+                          name + " float observation");
+      const auto gf = model.diffusion(t, xf);
+      const auto gd = model.diffusion(t, x_rounded);
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < Model::noise_dim; ++j)
+          EXPECT_NEAR(gf(i, j), gd(i, j), 1e-6 * (1 + std::abs(gd(i, j)))) << name << " float diffusion";
+    }
     if constexpr (T::closed_form_expectations && n <= max_cubature_dim) {
       const GaussHermiteRule rule = make_gauss_hermite_rule(20);
       for (double s : {0.01, 0.5}) {
@@ -98,16 +113,18 @@ void expect_forms_match_drift(const Model& model) {
 }
 
 TEST(ModelForms, EveryFormAModelHasDescribesItsDrift) {
-  int checked = 0;
+  int checked = 0, with_float_dynamics = 0;
   detail::for_each_model_type([&](auto* tag) {
     using Model = std::remove_pointer_t<decltype(tag)>;
     if constexpr (!Model::discrete_time) {
       expect_forms_match_drift(Model{});
       ++checked;
+      with_float_dynamics += has_float_dynamics<Model>::value;
     }
   });
-  EXPECT_EQ(checked, 13);  // ou, sine, cubic-oscillator, linear 1-3, car, car-taylor3, terpolymer, benes,
-                           // cubic-sensor, pendulum, range-bearing
+  EXPECT_EQ(checked, 13);             // ou, sine, cubic-oscillator, linear 1-3, car, car-taylor3, terpolymer, benes,
+                                      // cubic-sensor, pendulum, range-bearing
+  EXPECT_EQ(with_float_dynamics, 5);  // ou, sine, linear 1-3
 }
 
 TEST(ModelForms, ClosedFormExpectationsDifferFromThePointValues) {  // power: E_N[f] != f(m) for nonlinear f
