@@ -69,7 +69,7 @@ KUSHNER_SAME_CODE_FOR_ALL_CALLERS void particle_block_host(const ParticleStepDat
   const std::uint32_t step = particle_draw_step<Initialize>(d);
   const int first_pair = begin / 2;   // blocks start at even particles
   const int pairs = (count + 1) / 2;  // an odd count's last particle is the even half of its pair
-  if (d.fp32_normals)
+  if (d.float_normals())
     draw_block_normals<true, K>(key, member, first_pair, pairs, step, z);
   else
     draw_block_normals<false, K>(key, member, first_pair, pairs, step, z);

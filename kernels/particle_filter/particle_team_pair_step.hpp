@@ -84,7 +84,7 @@ struct ParticleTeamPairStep {
       for (int s = 0; s < 2; ++s) {
         Vec<K> z[B];
         double u[B];
-        draw_particle_batch<Model, false>(key, member, base, c.threads, d.step + s, d.fp32_normals, z, u);
+        draw_particle_batch<Model, false>(key, member, base, c.threads, d.step + s, d.float_normals(), z, u);
         KUSHNER_DEVICE_UNROLL
         for (int k = 0; k < B; ++k) {
           const int j = batch_particle(base, k, c.threads);
@@ -115,7 +115,7 @@ struct ParticleTeamPairStep {
     for (int pair = c.begin / 2 + c.rank; pair < (c.end + 1) / 2; pair += c.threads) {
       Vec<K> z[2];
       double u[2];
-      draw_particle_pair<Model, false>(key, member, pair, d.step, d.fp32_normals, z[0], z[1], u[0], u[1]);
+      draw_particle_pair<Model, false>(key, member, pair, d.step, d.float_normals(), z[0], z[1], u[0], u[1]);
       for (int k = 0; k < 2; ++k) {
         const int j = 2 * pair + k;
         if (j >= c.end) continue;

@@ -51,6 +51,10 @@ struct ParticleStepData {
   int num_particles = 0, block_size = 0;
   bool initialize = false;    // sample the initial law instead of propagating; no observation
   bool fp32_normals = false;  // the `mixed` and `fp32` precisions (particle_precision.hpp)
+
+  /// Whether the normals are drawn in float: always where particles are stored in float, which the compiler then
+  /// knows (fp32's kernels carry no fp64 Box-Muller), else as fp32_normals says.
+  KOKKOS_INLINE_FUNCTION bool float_normals() const { return std::is_same_v<Real, float> || fp32_normals; }
 };
 
 /// The second step of a fused pair (particle_team_pair_step.hpp): step + 1, over [t, t + dt]. The pair reads the
@@ -86,7 +90,7 @@ KOKKOS_INLINE_FUNCTION std::uint32_t particle_draw_step(const ParticleStepData<M
 
 /// The draws of particles 2 pair (z0, u0) and 2 pair + 1 (z1, u1) of `member` at `step`, from Random123's Philox
 /// (the team kernels; the host kernel draws a block at a time with SimdDraws, the same bits); normals in float
-/// with `fp32` (ParticleStepData::fp32_normals, the same for every thread: no divergence).
+/// with `fp32` (ParticleStepData::float_normals, the same for every thread: no divergence).
 template <class Model, bool Initialize>
 KOKKOS_INLINE_FUNCTION void draw_particle_pair(const RngKey& key, int member, int pair, std::uint32_t step, bool fp32,
                                                Vec<particle_draw_dim<Model, Initialize>>& z0,
