@@ -194,6 +194,29 @@ TEST(ParticleFilterBank, TeamKernelAgreesWithHostBlockKernel) {
   }
 }
 
+/// The runs of the two re-sum tests: 5 steps of dt = 0.01, member 1's increment `outlier` at steps 1 and 4 (the
+/// other members' small), taken by the host kernel (`host`), the team kernel a step at a time (`team`) and in pairs
+/// (`pairs`: steps (1, 2) and (3, 4), so the outlier is once in a pair's first step and once in its second).
+/// after(k) checks the banks after step k.
+template <class Bank, class After>
+void step_through_outliers(Bank& host, Bank& team, Bank& pairs, double outlier, const After& after) {
+  std::vector<BankVector<Kokkos::HostSpace>> dy;
+  for (int k = 0; k < 5; ++k) {
+    dy.emplace_back("dy", host.num_members(), 1);
+    dy[k](0, 0) = 0.01;
+    dy[k](1, 0) = k == 1 || k == 4 ? outlier : 0.01;
+    dy[k](2, 0) = -0.02;
+  }
+  for (int k = 0; k < 5; ++k) {
+    host.step(k, 0.01, dy[k]);
+    team.step(k, 0.01, dy[k]);
+    if (k == 0) pairs.step(k, 0.01, dy[k]);
+    if (k == 2 || k == 4) pairs.step_pair(k - 1, 0.01, dy[k - 1], dy[k]);
+    Host().fence();
+    after(k);
+  }
+}
+
 TEST(ParticleFilterBank, TeamKernelResumsWhenTheWeightBoundIsFarOff) {
   // The team kernel sums exp(l - s) with s = dy^T V^-1 dy / (2 dt), the largest log-weight any particle could
   // get. A large dy puts s hundreds of nats above every particle's l: the kernel must notice and sum again
@@ -209,13 +232,6 @@ TEST(ParticleFilterBank, TeamKernelResumsWhenTheWeightBoundIsFarOff) {
   ParticleFilterBank<Host, SineModel> pb(Host(), model, members, particles, seed, block);
   ParticleFilterBank<Host, SineModel> pt(Host(), model, members, particles, seed, team);
   ParticleFilterBank<Host, SineModel> pp(Host(), model, members, particles, seed, team);
-  std::vector<BankVector<Kokkos::HostSpace>> dy;
-  for (int k = 0; k < 5; ++k) {
-    dy.emplace_back("dy", members, 1);
-    dy[k](0, 0) = 0.01;
-    dy[k](1, 0) = k == 1 || k == 4 ? 30.0 : 0.01;  // s - max l ~ 0.5 * 30^2 / 0.01 at steps 1 and 4
-    dy[k](2, 0) = -0.02;
-  }
   auto expect_agree = [&](const ParticleFilterBank<Host, SineModel>& p, const char* which, int k) {
     Host().fence();
     for (int m = 0; m < members; ++m) {
@@ -239,15 +255,12 @@ TEST(ParticleFilterBank, TeamKernelResumsWhenTheWeightBoundIsFarOff) {
       EXPECT_LE(worst_excess, 0.0) << which << " step " << k << " member " << m << " particle " << worst;
     }
   };
-  for (int k = 0; k < 5; ++k) {
-    pb.step(k, 0.01, dy[k]);
-    pt.step(k, 0.01, dy[k]);
-    if (k == 0) pp.step(k, 0.01, dy[k]);
-    if (k == 2 || k == 4) pp.step_pair(k - 1, 0.01, dy[k - 1], dy[k]);
+  // s - max l ~ 0.5 * 30^2 / 0.01 at the outlier's steps
+  step_through_outliers(pb, pt, pp, 30.0, [&](int k) {
     expect_agree(pt, "step", k);
     if (k == 1) EXPECT_LT(pt.effective_sample_size()(1), 0.1 * particles);  // the outlier did concentrate the weights
     if (k % 2 == 0) expect_agree(pp, "step_pair", k);
-  }
+  });
 }
 
 TEST(ParticleFilterBank, Fp32TeamKernelResumsWhereFloatExpUnderflows) {
@@ -266,13 +279,6 @@ TEST(ParticleFilterBank, Fp32TeamKernelResumsWhereFloatExpUnderflows) {
   Bank pb(Host(), model, members, particles, seed, block);
   Bank pt(Host(), model, members, particles, seed, team);
   Bank pp(Host(), model, members, particles, seed, team);
-  std::vector<BankVector<Kokkos::HostSpace>> dy;
-  for (int k = 0; k < 5; ++k) {
-    dy.emplace_back("dy", members, 1);
-    dy[k](0, 0) = 0.01;
-    dy[k](1, 0) = k == 1 || k == 4 ? 0.7 : 0.01;  // s = 0.7^2 / (2 r^2 dt) = 98 nats
-    dy[k](2, 0) = -0.02;
-  }
   auto expect_agree = [&](const Bank& p, const char* which, int k) {
     Host().fence();
     for (int m = 0; m < members; ++m) {
@@ -283,13 +289,8 @@ TEST(ParticleFilterBank, Fp32TeamKernelResumsWhereFloatExpUnderflows) {
       EXPECT_NEAR(p.posterior_covariance()(m, 0), cov, 1e-5 * cov) << which << " step " << k << " member " << m;
     }
   };
-  for (int k = 0; k < 5; ++k) {
-    pb.step(k, 0.01, dy[k]);
-    pt.step(k, 0.01, dy[k]);
-    if (k == 0) pp.step(k, 0.01, dy[k]);
-    if (k == 2 || k == 4) pp.step_pair(k - 1, 0.01, dy[k - 1], dy[k]);
+  step_through_outliers(pb, pt, pp, 0.7, [&](int k) {  // s = 0.7^2 / (2 r^2 dt) = 98 nats at the outlier's steps
     if (k == 1) {  // the largest l of the outlier member lies between float's range and fp64's 200 nats below s
-      Host().fence();
       double top = -math::infinity();
       for (int j = 0; j < particles; ++j) top = std::max(top, double(pb.log_weights()(j, 1)));
       const double gap = 0.5 * 0.7 * 0.7 / (model.r * model.r * 0.01) - top;  // stored l: already normalized
@@ -299,7 +300,7 @@ TEST(ParticleFilterBank, Fp32TeamKernelResumsWhereFloatExpUnderflows) {
     }
     expect_agree(pt, "step", k);
     if (k % 2 == 0) expect_agree(pp, "step_pair", k);
-  }
+  });
 }
 
 /// Posterior mean, covariance and ESS of every member, and the resampling counts.
