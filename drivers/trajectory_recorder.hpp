@@ -123,6 +123,13 @@ class TrajectoryRecorder {
     }
   }
 
+  /// The (global) members operator() reads: the chosen ones and the scanned ones.
+  std::vector<long> members_read() const {
+    std::vector<long> read = members_;
+    for (long m = 0; m < bimodal_.scanned_members; ++m) read.push_back(m);
+    return read;
+  }
+
   const std::string& trajectories_csv() const { return trajectories_; }
   /// Empty unless a density snapshot was taken (a run with the particle filter).
   std::string density_csv() const {

@@ -11,6 +11,7 @@
 #include "engine/shared_instances.hpp"
 #include "engine/truth_bank.hpp"
 #include "kernels/ensemble_moments.hpp"
+#include "kernels/filters/filter_bank_segment.hpp"
 #include "kernels/filters/filter_bank_step.hpp"
 #include "kernels/filters/filter_list.hpp"
 #include "kernels/filters/filter_metrics.hpp"
@@ -21,6 +22,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <tuple>
@@ -189,6 +191,26 @@ class FilterBank {
            static_cast<double>(filters) * (sizeof(double) * n + sizeof(Status));
   }
 
+  /// Whether step_segment may run: a host bank with no estimator stepped beside it.
+  bool steps_in_segments() const {
+    return std::is_same<MemSpace, Kokkos::HostSpace>::value && reference_ == nullptr && estimators_.empty();
+  }
+
+  /// Steps a segment takes at most (run_filters): 16 steps keep a block's columns in a core's cache for 16 times
+  /// fewer trips to memory, and their block statistics (output steps) in a few MB.
+  static constexpr int segment_steps = 16;
+
+  /// Steps k .. k + outputs.size() - 1 in one pass over blocks of members (temporal blocking:
+  /// kernels/filters/filter_bank_segment.hpp), with the numbers of step() one step at a time (steps_in_segments()).
+  /// outputs[s] != 0: step k + s ends at an output time. The members `watched` (indices into this bank) take the steps
+  /// one at a time first, and after each output step at_output(s) is called with them there: every other member is
+  /// then at the segment's start, so at_output may read only the watched ones. Returns snapshots(names) of each output
+  /// step, in order (a collective call over the ranks, as finish_snapshots is).
+  std::vector<std::vector<FilterSnapshot>> step_segment(long k, double dt, const std::vector<char>& outputs,
+                                                        const std::vector<std::string>& names,
+                                                        const std::vector<long>& watched = {},
+                                                        const std::function<void(int)>& at_output = {});
+
   const TruthBank<ExecSpace, TruthModel>& truths() const { return truths_; }
   /// (member): non_finite once the member's truth escaped to infinity.
   const BankScalar<Status, MemSpace>& truth_status() const { return truth_status_; }
@@ -330,13 +352,20 @@ class FilterBank {
     return reference_ != nullptr && name != reference_->name();
   }
 
-  void run_step_kernel(long k, double dt, bool record) {
+  typename K::Step step_kernel(long k, double dt, bool record) const {
     const auto step = static_cast<std::uint32_t>(k);
-    typename K::Step kernel{
+    return {
         TruthStep<TruthModel, MemSpace>{truth_model_, truths_.state(), truths_.observations(), k * dt, dt, seed_, step},
         filter_model_, truth_status_, slots_, record};
-    parallel_for_members("kushner::filter_bank_step", space_, members_, kernel);
   }
+
+  void run_step_kernel(long k, double dt, bool record) {
+    parallel_for_members("kushner::filter_bank_step", space_, members_, step_kernel(k, dt, record));
+  }
+
+  /// The snapshots of `names` (their columns start at first[i] in `merged`: squared error, NEES[, reference]).
+  std::vector<FilterSnapshot> snapshots_of(const MergedBlocks& merged, const std::vector<std::string>& names,
+                                           const std::vector<int>& first) const;
 
   /// Scores every filter against the reference, and every outside estimator, at the time the bank is at.
   void score_now(bool record) {
@@ -405,6 +434,7 @@ class FilterBank {
     std::vector<int> first;  // names[i]'s first column in snapshot_moments_
   };
   mutable PendingSnapshots pending_;
+  std::vector<double> segment_rows_;  // step_segment's block statistics, kept from one segment to the next
 };
 
 template <class ExecSpace, class Model, class TruthModel>
@@ -513,11 +543,14 @@ template <class ExecSpace, class Model, class TruthModel>
 std::vector<FilterSnapshot> FilterBank<ExecSpace, Model, TruthModel>::finish_snapshots() const {
   KUSHNER_REQUIRE(pending_.started, "finish_snapshots: no snapshots started");
   pending_.started = false;
-  const MergedBlocks merged = snapshot_moments_.finish();
+  return snapshots_of(snapshot_moments_.finish(), pending_.names, pending_.first);
+}
+
+template <class ExecSpace, class Model, class TruthModel>
+std::vector<FilterSnapshot> FilterBank<ExecSpace, Model, TruthModel>::snapshots_of(
+    const MergedBlocks& merged, const std::vector<std::string>& names, const std::vector<int>& first) const {
   const std::vector<EnsembleMoments>& moments = merged.moments;
   const std::vector<long>& diverged = merged.counts;  // per filter of names
-  const std::vector<std::string>& names = pending_.names;
-  const std::vector<int>& first = pending_.first;  // names[i]'s columns start at first[i]: squared error, NEES[, ref]
   std::vector<FilterSnapshot> result;
   for (std::size_t i = 0; i < names.size(); ++i) {
     FilterSnapshot s;
@@ -533,6 +566,86 @@ std::vector<FilterSnapshot> FilterBank<ExecSpace, Model, TruthModel>::finish_sna
     s.rmse_ref_se = ref.standard_error;
     s.diverged = diverged[i];
     result.push_back(s);
+  }
+  return result;
+}
+
+template <class ExecSpace, class Model, class TruthModel>
+std::vector<std::vector<FilterSnapshot>> FilterBank<ExecSpace, Model, TruthModel>::step_segment(
+    const long k, const double dt, const std::vector<char>& outputs, const std::vector<std::string>& names,
+    const std::vector<long>& watched, const std::function<void(int)>& at_output) {
+  KUSHNER_REQUIRE(steps_in_segments(), "step_segment: a device bank, or estimators beside the bank");
+  std::vector<std::vector<FilterSnapshot>> result;
+  if constexpr (std::is_same<MemSpace, Kokkos::HostSpace>::value) {
+    using Step = typename K::Step;
+    const int steps = static_cast<int>(outputs.size());
+    std::vector<int> output_of(steps, -1);
+    int num_outputs = 0, last_output = -1;
+    for (int s = 0; s < steps; ++s)
+      if (outputs[s]) {
+        output_of[s] = num_outputs++;
+        last_output = s;
+      }
+    // start_snapshots' columns (no reference here: two per filter) and counts.
+    std::vector<SegmentColumn> columns;
+    std::vector<BankScalar<Status, MemSpace>> statuses;
+    std::vector<int> first;
+    for (const auto& name : names) {
+      bool found = false;
+      for_each_filter_slot(slots_, [&](const auto& slot) {
+        using Filter = decltype(slot.filter);
+        if (!slot.enabled || name != Filter::name) return;
+        found = true;
+        first.push_back(static_cast<int>(columns.size()));
+        const int sink = Step::template fills_sink<Filter>() ? 2 * Step::template slot_index<Filter>() : -1;
+        double* const snapshot = slot.snapshot.data();
+        const std::size_t stride = slot.snapshot.stride(1);
+        columns.push_back({snapshot + snapshot_squared_error * stride, sink});
+        columns.push_back({snapshot + snapshot_nees * stride, sink < 0 ? -1 : sink + 1});
+        statuses.push_back(slot.status);
+      });
+      KUSHNER_REQUIRE(found, "filter '" << name << "' is not in this bank");
+    }
+    const NotOkMembers<MemSpace> counted = diverged_members_(space_, statuses, truth_status_);
+    const int num_columns = static_cast<int>(columns.size()), width = 3 * num_columns + counted.columns();
+    const int num_blocks = static_cast<int>(moment_blocks(members_));
+    const std::size_t output_size = static_cast<std::size_t>(num_blocks) * width;
+    segment_rows_.resize(output_size * num_outputs);
+    std::vector<int> watched_blocks;
+    for (const long member : watched) {
+      KUSHNER_REQUIRE(member >= 0 && member < members_,
+                      "step_segment: watched member " << member << " not in the bank");
+      watched_blocks.push_back(static_cast<int>(member / moment_block_size));
+    }
+    std::sort(watched_blocks.begin(), watched_blocks.end());
+    watched_blocks.erase(std::unique(watched_blocks.begin(), watched_blocks.end()), watched_blocks.end());
+    const FilterBankSegment<Step, NotOkMembers<MemSpace>> segment{step_kernel(k, dt, false),
+                                                                  k,
+                                                                  steps,
+                                                                  dt,
+                                                                  output_of.data(),
+                                                                  last_output,
+                                                                  columns.data(),
+                                                                  num_columns,
+                                                                  counted,
+                                                                  segment_rows_.data(),
+                                                                  num_blocks,
+                                                                  width,
+                                                                  static_cast<int>(members_),
+                                                                  watched_blocks.data(),
+                                                                  static_cast<int>(watched_blocks.size())};
+    space_.fence();
+    for (int s = 0; s < steps; ++s) {
+      for (const int b : watched_blocks) segment.run_block(b, s, s + 1);
+      if (outputs[s] && at_output) at_output(s);
+    }
+    Kokkos::parallel_for("kushner::filter_bank_segment", Kokkos::RangePolicy<ExecSpace>(space_, 0, num_blocks),
+                         segment);
+    space_.fence();
+    for (int o = 0; o < num_outputs; ++o)
+      result.push_back(snapshots_of(merge_block_statistics(segment_rows_.data() + o * output_size, output_size,
+                                                           num_columns, counted.columns(), members_),
+                                    names, first));
   }
   return result;
 }

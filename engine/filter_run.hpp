@@ -45,12 +45,20 @@ struct FilterReport {
   long steps_run = 0;                           // steps of the main pass this process ran (fewer when resumed)
 };
 
-/// Called at t = 0 and at every output time with the bank and the outside estimators (PF, EXACT), e.g. to
-/// record chosen members' trajectories.
+/// `observe` is called at t = 0 and at every output time with the bank and the outside estimators (PF, EXACT), e.g.
+/// to record chosen members' trajectories. It may read the global members `members` only: a host run without outside
+/// estimators takes several steps at a time (FilterBank::step_segment), and at an output time only those are there.
 template <class ExecSpace, class Model, class TruthModel = Model>
-using OutputObserver =
-    std::function<void(double t, const FilterBank<ExecSpace, Model, TruthModel>&,
-                       const std::vector<const ReferenceEstimator<typename ExecSpace::memory_space>*>&)>;
+struct OutputObserver {
+  std::function<void(double t, const FilterBank<ExecSpace, Model, TruthModel>&,
+                     const std::vector<const ReferenceEstimator<typename ExecSpace::memory_space>*>&)>
+      observe;
+  std::vector<long> members;
+};
+
+/// Fewest members (of all ranks) for which a host run takes its steps in segments: below it the blocks of
+/// moment_block_size members are too few to share among the threads, and one step at a time costs little.
+constexpr long segment_min_members = 16 * moment_block_size;
 
 /// Estimators a caller adds beside the bank (e.g. `kushner reproduce`'s exact quadrature for a deterministic
 /// model, or a paper's printed variant of a filter); run_filters owns them from then on.
@@ -176,7 +184,7 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
     report.times.push_back(t);
     bank.start_snapshots(report.filters);
     collecting = true;
-    if (observer) observer(t, bank, outside_view);
+    if (observer.observe) observer.observe(t, bank, outside_view);
   };
   const auto collect = [&] {
     if (collecting) report.series.push_back(bank.finish_snapshots());
@@ -229,21 +237,50 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
   const auto ends_at_output = [&](long step) {
     return next_output < grid.output_steps.size() && grid.output_steps[next_output] == step;
   };
-  for (long k = first_step; k < grid.steps;) {
-    // Two steps at a time where the reference takes them in one pass (FilterBank::step_pair), unless the first
-    // ends at an output time (its metrics are read there) or is the last.
-    const bool pair = bank.steps_in_pairs() && !ends_at_output(k + 1) && k + 2 <= grid.steps;
-    const long done = k + (pair ? 2 : 1);
-    const bool output = ends_at_output(done);
-    if (pair)
-      bank.step_pair(k, grid.dt, output);
-    else
-      bank.step(k, grid.dt, output);
+  // Several steps at a time where nothing steps beside the bank on the host (FilterBank::step_segment); the same on
+  // every rank (the total member count), as every rank must make the same collective calls.
+  const bool segments = bank.steps_in_segments() && share.total >= segment_min_members;
+  std::vector<long> watched;  // the observer's members in this rank's bank
+  for (const long member : observer.members)
+    if (share.holds(member)) watched.push_back(member - share.first);
+  const auto take_segment = [&](const long k) {
     collect();
-    k = done;
-    if (output) {
-      record(k * grid.dt);
-      ++next_output;
+    const long steps = std::min<long>(FilterBank<ExecSpace, Model, TruthModel>::segment_steps, grid.steps - k);
+    std::vector<char> outputs(steps, 0);
+    for (std::size_t s = 0, o = next_output; s < outputs.size(); ++s) {
+      outputs[s] = o < grid.output_steps.size() && grid.output_steps[o] == k + static_cast<long>(s) + 1;
+      if (outputs[s]) ++o;
+    }
+    const auto series = bank.step_segment(k, grid.dt, outputs, report.filters, watched, [&](int s) {
+      if (observer.observe) observer.observe((k + s + 1) * grid.dt, bank, outside_view);
+    });
+    for (long s = 0, o = 0; s < steps; ++s)
+      if (outputs[s]) {
+        report.times.push_back((k + s + 1) * grid.dt);
+        report.series.push_back(series[o++]);
+        ++next_output;
+      }
+    return k + steps;
+  };
+  for (long k = first_step; k < grid.steps;) {
+    if (segments) {
+      k = take_segment(k);
+    } else {
+      // Two steps at a time where the reference takes them in one pass (FilterBank::step_pair), unless the first
+      // ends at an output time (its metrics are read there) or is the last.
+      const bool pair = bank.steps_in_pairs() && !ends_at_output(k + 1) && k + 2 <= grid.steps;
+      const long done = k + (pair ? 2 : 1);
+      const bool output = ends_at_output(done);
+      if (pair)
+        bank.step_pair(k, grid.dt, output);
+      else
+        bank.step(k, grid.dt, output);
+      collect();
+      k = done;
+      if (output) {
+        record(k * grid.dt);
+        ++next_output;
+      }
     }
     if (progress) progress(progress_base + k);
     if (!checkpointing.saves()) continue;

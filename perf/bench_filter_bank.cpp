@@ -73,6 +73,31 @@ void BM_FilterBankOutputSteps(benchmark::State& state) {
     if (bank.scores(name, k + 1).diverged > 0) state.SkipWithError(("diverged members in " + name).c_str());
 }
 
+/// BM_FilterBankOutputSteps' steps taken FilterBank::segment_steps at a time (FilterBank::step_segment, as
+/// engine/filter_run.hpp takes them on the host), members 0 .. 2 watched (the command line's trajectories).
+template <class Model>
+void BM_FilterBankSegments(benchmark::State& state) {
+  const long members = state.range(0);
+  const bool output = state.range(1) != 0;
+  const Space space;
+  const std::vector<std::string> filters{"EKF", "SOF", "QLF", "KBL"};
+  using Bank = FilterBank<Space, Model>;
+  Bank bank(space, Model{}, Model{}, members, 42, filters);
+  const std::vector<char> outputs(Bank::segment_steps, output ? 1 : 0);
+  long k = 0;
+  for (auto _ : state) {
+    Kokkos::Timer timer;
+    bank.step_segment(k, 1e-3, outputs, filters, {0, 1, 2});
+    k += Bank::segment_steps;
+    state.SetIterationTime(timer.seconds());
+  }
+  using C = benchmark::Counter;
+  state.counters["member_steps_per_s"] =
+      C(static_cast<double>(members) * Bank::segment_steps, C::kIsIterationInvariantRate);
+  for (const auto& name : filters)
+    if (bank.scores(name, k + 1).diverged > 0) state.SkipWithError(("diverged members in " + name).c_str());
+}
+
 /// The baseline: the same truths stepped alone (what `kushner simulate` does per step).
 template <class Model>
 void BM_TruthStepAlone(benchmark::State& state) {
@@ -99,6 +124,14 @@ BENCHMARK_TEMPLATE(BM_FilterBankStep, SineModel)
     ->UseManualTime();
 BENCHMARK_TEMPLATE(BM_FilterBankOutputSteps, SineModel)
     ->ArgNames({"members", "output"})
+    ->Args({8192, 1})
+    ->Args({8192, 0})
+    ->Args({1000000, 1})
+    ->Args({1000000, 0})
+    ->UseManualTime();
+BENCHMARK_TEMPLATE(BM_FilterBankSegments, SineModel)
+    ->ArgNames({"members", "output"})
+    ->Args({8192, 1})
     ->Args({1000000, 1})
     ->Args({1000000, 0})
     ->UseManualTime();

@@ -10,6 +10,7 @@
 #include <Kokkos_Core.hpp>
 
 #include <cstdint>
+#include <type_traits>
 
 namespace kushner {
 
@@ -23,11 +24,31 @@ template <class Model, class TruthModel, class MemSpace, class... Filters>
 struct FilterBankStep {
   static_assert(TruthModel::state_dim == Model::state_dim && TruthModel::obs_dim == Model::obs_dim,
                 "FilterBankStep: the truths' model and the filters' model must have the same dimensions");
+  static constexpr int num_filters = sizeof...(Filters);
   TruthStep<TruthModel, MemSpace> truth;
   Model model;
   BankScalar<Status, MemSpace> truth_status;  // non_finite once a truth escaped: not filtered, not scored
   FilterSlots<MemSpace, Filters...> slots;
   bool record;  // the step ends at an output time: fill the snapshots
+  // Host segments (kernels/filters/filter_bank_segment.hpp): where the filters that fills_sink() put a chunk's
+  // snapshot values instead of their snapshot columns: filter slot_index<Filter>()'s column c of member m at
+  // snapshot_sink[(2 slot_index + c) * sink_stride + m - sink_first]. Null: the columns.
+  double* snapshot_sink = nullptr;
+  int sink_first = 0, sink_stride = 0;
+
+  /// Filter's place among Filters... (the sink's order).
+  template <class Filter>
+  static constexpr int slot_index() {
+    int index = 0, found = -1;
+    ((found = found < 0 && std::is_same<Filter, Filters>::value ? index : found, ++index), ...);
+    return found;
+  }
+  /// Whether run_chunk gives Filter's snapshot values to the sink (its lanes: filter_lanes); the others write their
+  /// snapshot columns member by member (advance).
+  template <class Filter>
+  static constexpr bool fills_sink() {
+    return !(Model::discrete_time || TruthModel::discrete_time) && filter_step_is_pure<Filter, Model::state_dim>;
+  }
 
   KOKKOS_INLINE_FUNCTION void operator()(const int member) const {
     constexpr int n = Model::state_dim, p = Model::obs_dim;
@@ -131,7 +152,12 @@ struct FilterBankStep {
     const std::size_t x_stride = truth.x.stride(1), dy_stride = truth.dy.stride(1);
     const double t = truth.t, dt = truth.dt;
     std::int64_t status[host_member_chunk];  // 64-bit: see advance_lane
-    double error[host_member_chunk], nees[host_member_chunk];
+    // The lanes' snapshot values: straight into the block's sink where there is one (an output step of a segment),
+    // else into `chunk`, from where an output step stores them in the snapshot columns.
+    double chunk[2 * host_member_chunk];
+    const bool to_sink = Record && snapshot_sink != nullptr;
+    double* const error = to_sink ? snapshot_sink + 2 * slot_index<Filter>() * sink_stride + begin - sink_first : chunk;
+    double* const nees = to_sink ? error + sink_stride : chunk + host_member_chunk;
     for (int member = begin; member < end; ++member)
       status[member - begin] = static_cast<std::int64_t>(slot.status(member));
     KUSHNER_SIMD
@@ -144,6 +170,7 @@ struct FilterBankStep {
     if constexpr (Record) {
       // The reference column is not touched: with a reference, its score (FilterBankReferenceScore, after the step
       // at every output time) writes it for every member; without one nothing reads it.
+      if (to_sink) return;
       // Streaming stores (fenced at the chunk's end, run_chunk): only the output step's reductions read these
       // columns, after the step.
       double* const snapshot = slot.snapshot.data();

@@ -84,6 +84,15 @@ struct NotOkMembers {
     const Status truth = truth_status(m), status = reinterpret_cast<const Status*>(statuses(s))[m];  // both read:
     return (truth == Status::ok) & (status != Status::ok);  // no branch between the reads (warp_block_count)
   }
+  /// The members m in [begin, end) that count in column s, on the host (FilterBankSegment): one plain loop over the
+  /// two byte columns (operator() looks column s up for every member).
+  int count(const int s, const int begin, const int end) const {
+    const Status* const status = reinterpret_cast<const Status*>(statuses(s));
+    const Status* const truth = truth_status.data();
+    int count = 0;
+    for (int m = begin; m < end; ++m) count += (truth[m] == Status::ok) & (status[m] != Status::ok);
+    return count;
+  }
 };
 
 /// NotOkMembers of status columns of one bank; keeps its device list of the columns from call to call (a bank

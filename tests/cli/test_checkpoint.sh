@@ -166,6 +166,25 @@ for f in summary.json timeseries.csv trajectories.csv density.csv; do
 done
 rm -rf "$work/run"
 
+# The bank alone on the host from 4096 members takes its steps in segments (FilterBank::step_segment), so its
+# checkpoints fall between segments: killed at one, stopped by SIGINT at another, resumed, the same files.
+segments=(compare --model sine --filters EKF,QLF,UKF,EnKBF --enkbf-particles 20 --members 5000 --T 2 --dt 1e-3
+          --output-points 300 --trajectory-members 0,4500 --no-plots --quiet --seed 8 --checkpoint-every 0.05)
+export KUSHNER_BACKEND=openmp OMP_NUM_THREADS=2
+"$kushner" "${segments[@]}" --out "$work/run" > /dev/null
+mv "$work/run" "$work/segments-reference"
+"$kushner" "${segments[@]}" --out "$work/run" > /dev/null 2>&1 &
+kill_after_step "$work/run" 500 $!
+"$kushner" resume "$work/run" > /dev/null 2>&1 &
+pid=$!
+signal_after_step INT "$work/run" 1200 $pid
+wait $pid || true
+[ -e "$work/run/checkpoint.kushner" ] || fail "segments: SIGINT left no checkpoint"
+"$kushner" resume "$work/run" > /dev/null
+same_files "$work/segments-reference" "$work/run"
+echo "ok: segments: SIGKILL and SIGINT at checkpoints between segments, resumed: every file byte for byte"
+rm -rf "$work/run"
+
 # A model file changed between the stop and the resume: the state is of another model.
 model="$work/linear2.toml"
 cp "$(dirname "$0")/../../models/examples/linear2.toml" "$model"

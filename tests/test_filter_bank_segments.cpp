@@ -1,0 +1,228 @@
+// FilterBank::step_segment (a host bank's steps taken several at a time, each block of members through all of them:
+// kernels/filters/filter_bank_segment.hpp) against the same bank stepped one step at a time: the snapshots of every
+// output step, the watched members at each output time, and all the bank holds at the end (truths, each filter's m,
+// P, status, score sums and snapshot columns) are the same bits. For sine with every filter it supports (lanes that
+// write the block's sink, and EnKBF and ASRE, which step member by member into the snapshot columns), the cubic
+// sensor (SOF loses positive definiteness on some members: the divergence counts), and a discrete-time model. 1100
+// members: four whole blocks of 256 and a short one. Then run_filters, which takes segments on the host from 4096
+// members, against a bank stepped by hand.
+#include "engine/filter_run.hpp"
+#include "kernels/filters/filter_list.hpp"
+#include "models/cubic_sensor_model.hpp"
+#include "models/linear_discrete_model.hpp"
+#include "models/sine_model.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <cstring>
+#include <string>
+#include <vector>
+
+namespace kushner {
+namespace {
+
+using Space = Kokkos::DefaultHostExecutionSpace;
+using MemSpace = Space::memory_space;
+
+/// a and b are the same bits (NaN equals NaN).
+bool same_bits(double a, double b) {
+  std::uint64_t x, y;
+  std::memcpy(&x, &a, sizeof x);
+  std::memcpy(&y, &b, sizeof y);
+  return x == y;
+}
+
+void expect_same_snapshots(const std::vector<FilterSnapshot>& steps, const std::vector<FilterSnapshot>& segments,
+                           const std::string& where) {
+  ASSERT_EQ(steps.size(), segments.size()) << where;
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    const FilterSnapshot &a = steps[i], &b = segments[i];
+    EXPECT_TRUE(same_bits(a.rmse_truth, b.rmse_truth))
+        << where << " filter " << i << ": " << a.rmse_truth << " vs " << b.rmse_truth;
+    EXPECT_TRUE(same_bits(a.rmse_truth_se, b.rmse_truth_se)) << where << " filter " << i;
+    EXPECT_TRUE(same_bits(a.nees, b.nees)) << where << " filter " << i << ": " << a.nees << " vs " << b.nees;
+    EXPECT_TRUE(same_bits(a.nees_se, b.nees_se)) << where << " filter " << i;
+    EXPECT_TRUE(same_bits(a.rmse_ref, b.rmse_ref)) << where << " filter " << i;
+    EXPECT_EQ(a.diverged, b.diverged) << where << " filter " << i;
+  }
+}
+
+template <class View>
+void expect_same_view(const View& a, const View& b, const std::string& what) {
+  const auto ha = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), a);
+  const auto hb = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), b);
+  ASSERT_EQ(ha.span(), hb.span()) << what;
+  long differ = 0;
+  for (std::size_t i = 0; i < ha.span(); ++i) {
+    if constexpr (std::is_same<typename View::non_const_value_type, double>::value)
+      differ += same_bits(ha.data()[i], hb.data()[i]) ? 0 : 1;
+    else
+      differ += ha.data()[i] == hb.data()[i] ? 0 : 1;
+  }
+  EXPECT_EQ(differ, 0) << what << ": entries that differ";
+}
+
+/// The truth and every filter's estimate of `member`, as an observer at an output time reads them.
+template <class Bank>
+std::vector<double> member_values(const Bank& bank, const std::vector<std::string>& filters, long member) {
+  std::vector<double> values;
+  const auto take = [&](const auto& view) {
+    const auto row =
+        Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), Kokkos::subview(view, member, Kokkos::ALL));
+    for (std::size_t i = 0; i < row.extent(0); ++i) values.push_back(row(i));
+  };
+  take(bank.truths().state());
+  for (const auto& name : filters) bank.with_slot(name, [&](const auto& slot) { take(slot.m); });
+  return values;
+}
+
+/// Steps [0, sum of `segments`) with output steps at the ends of steps `output_ends` (k + 1 for step k), one step at a
+/// time and in segments of the given sizes, members `watched` read at each output time; then everything compared.
+template <class Model>
+void expect_segments_match_steps(const Model& model, const std::vector<std::string>& filters, double dt,
+                                 const std::vector<int>& segments, const std::vector<long>& output_ends) {
+  constexpr long members = 1100;
+  const std::vector<long> watched{0, 700};
+  const Seed seed(20261128);
+  using Bank = FilterBank<Space, Model>;
+  Bank steps(Space(), model, model, members, seed, filters);
+  Bank segmented(Space(), model, model, members, seed, filters);
+  long total = 0;
+  for (const int size : segments) total += size;
+  const auto is_output = [&](long end) {
+    return std::find(output_ends.begin(), output_ends.end(), end) != output_ends.end();
+  };
+
+  std::vector<std::vector<FilterSnapshot>> step_snapshots;
+  std::vector<std::vector<double>> step_watched;
+  for (long k = 0; k < total; ++k) {
+    const bool record = is_output(k + 1);
+    steps.step(k, dt, record);
+    if (!record) continue;
+    step_snapshots.push_back(steps.snapshots(filters));
+    for (const long member : watched) step_watched.push_back(member_values(steps, filters, member));
+  }
+  ASSERT_EQ(step_snapshots.size(), output_ends.size());
+
+  std::vector<std::vector<FilterSnapshot>> segment_snapshots;
+  std::vector<std::vector<double>> segment_watched;
+  long k = 0;
+  for (const int size : segments) {
+    std::vector<char> outputs(size);
+    for (int s = 0; s < size; ++s) outputs[s] = is_output(k + s + 1) ? 1 : 0;
+    const auto snapshots = segmented.step_segment(k, dt, outputs, filters, watched, [&](int) {
+      for (const long member : watched) segment_watched.push_back(member_values(segmented, filters, member));
+    });
+    segment_snapshots.insert(segment_snapshots.end(), snapshots.begin(), snapshots.end());
+    k += size;
+  }
+  ASSERT_EQ(segment_snapshots.size(), step_snapshots.size());
+  for (std::size_t o = 0; o < step_snapshots.size(); ++o)
+    expect_same_snapshots(step_snapshots[o], segment_snapshots[o], "output at step " + std::to_string(output_ends[o]));
+  ASSERT_EQ(segment_watched.size(), step_watched.size());
+  for (std::size_t i = 0; i < step_watched.size(); ++i) {
+    ASSERT_EQ(segment_watched[i].size(), step_watched[i].size());
+    for (std::size_t j = 0; j < step_watched[i].size(); ++j)
+      EXPECT_TRUE(same_bits(segment_watched[i][j], step_watched[i][j]))
+          << "watched member " << watched[i % watched.size()] << " at output " << i / watched.size() << ", value " << j;
+  }
+
+  expect_same_view(steps.truths().state(), segmented.truths().state(), "truths");
+  expect_same_view(steps.truths().observations(), segmented.truths().observations(), "observations");
+  expect_same_view(steps.truth_status(), segmented.truth_status(), "truth status");
+  for (const auto& name : filters) {
+    steps.with_slot(name, [&](const auto& a) {
+      segmented.with_slot(name, [&](const auto& b) {
+        expect_same_view(a.m, b.m, name + " m");
+        expect_same_view(a.P, b.P, name + " P");
+        expect_same_view(a.status, b.status, name + " status");
+        expect_same_view(a.score, b.score, name + " score sums");
+        expect_same_view(a.snapshot, b.snapshot, name + " snapshot columns");
+      });
+    });
+    const FilterScores a = steps.scores(name, total + 1), b = segmented.scores(name, total + 1);
+    EXPECT_TRUE(same_bits(a.rmse_truth.value, b.rmse_truth.value)) << name;
+    EXPECT_TRUE(same_bits(a.nees.value, b.nees.value)) << name;
+    EXPECT_EQ(a.diverged, b.diverged) << name;
+  }
+}
+
+TEST(FilterBankSegments, SineWithEveryFilterGivesTheNumbersOfStepsOneAtATime) {
+  // Outputs: at a segment's first step, inside it, at its end, two in a row; the last one before the last step.
+  expect_segments_match_steps(SineModel{}, supported_filters(SineModel{}), 1e-2, {16, 3, 16, 5},
+                              {1, 2, 7, 16, 17, 19, 30, 31, 38});
+}
+
+TEST(FilterBankSegments, DivergingMembersAreCountedAsOneStepAtATimeCountsThem) {
+  const CubicSensorModel model;
+  std::vector<char> diverged;
+  expect_segments_match_steps(model, {"SOF", "SOF-B", "EKF"}, 1e-2, {16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16},
+                              {16, 50, 100, 150, 192});
+  FilterBank<Space, CubicSensorModel> bank(Space(), model, model, 1100, Seed(20261128), {"SOF"});
+  for (long k = 0; k < 192; ++k) bank.step(k, 1e-2, false);
+  EXPECT_GT(bank.scores("SOF", 193).diverged, 0) << "no member diverged: the counts were not tested";
+}
+
+TEST(FilterBankSegments, DiscreteTimeModelGivesTheNumbersOfStepsOneAtATime) {
+  expect_segments_match_steps(LinearDiscreteModel{}, supported_filters(LinearDiscreteModel{}), 1.0, {16, 9},
+                              {1, 5, 16, 24});
+}
+
+/// The observer's view of run_filters' watched members, and the report, against a bank stepped one step at a time.
+TEST(FilterBankSegments, RunFiltersTakesSegmentsWithTheNumbersOfStepsOneAtATime) {
+  constexpr long members = segment_min_members + 300;
+  const std::vector<std::string> filters{"EKF", "SOF", "QLF", "KBL"};
+  const TimeGrid grid = make_time_grid(0.05, 1e-3, 20);  // 50 steps, outputs every 2
+  const std::uint32_t seed = 11;
+  const std::vector<long> watched{2, members - 1};
+  constexpr long unwatched =
+      300;  // in a block of its own: where a segment leaves it at an output time says segments ran
+  using Bank = FilterBank<Space, SineModel>;
+  std::vector<std::vector<double>> seen, seen_unwatched;
+  OutputObserver<Space, SineModel> observer{[&](double, const Bank& bank, const auto&) {
+                                              for (const long m : watched)
+                                                seen.push_back(member_values(bank, filters, m));
+                                              seen_unwatched.push_back(member_values(bank, filters, unwatched));
+                                            },
+                                            watched};
+  const FilterReport report =
+      run_filters(Space(), SineModel{}, SineModel{}, members, seed, grid, filters, {}, {}, {}, observer);
+
+  Bank bank(Space(), SineModel{}, SineModel{}, members, member_share(members).seed(seed), filters);
+  std::vector<std::vector<double>> expected, expected_unwatched{member_values(bank, filters, unwatched)};
+  for (const long m : watched) expected.push_back(member_values(bank, filters, m));
+  std::vector<std::vector<FilterSnapshot>> series{bank.snapshots(filters)};
+  std::vector<double> times{0.0};
+  for (long k = 0, o = 1; k < grid.steps; ++k) {
+    const bool record = grid.output_steps[o] == k + 1;
+    bank.step(k, grid.dt, record);
+    if (!record) continue;
+    ++o;
+    series.push_back(bank.snapshots(filters));
+    times.push_back((k + 1) * grid.dt);
+    for (const long m : watched) expected.push_back(member_values(bank, filters, m));
+    expected_unwatched.push_back(member_values(bank, filters, unwatched));
+  }
+  ASSERT_EQ(report.times.size(), times.size());
+  for (std::size_t o = 0; o < times.size(); ++o) {
+    EXPECT_TRUE(same_bits(report.times[o], times[o])) << o;
+    expect_same_snapshots(series[o], report.series[o], "output " + std::to_string(o));
+  }
+  ASSERT_EQ(seen.size(), expected.size());
+  for (std::size_t i = 0; i < seen.size(); ++i)
+    for (std::size_t j = 0; j < seen[i].size(); ++j)
+      EXPECT_TRUE(same_bits(seen[i][j], expected[i][j])) << "observer's read " << i << ", value " << j;
+  long unwatched_elsewhere = 0;
+  for (std::size_t i = 0; i < expected_unwatched.size(); ++i)
+    unwatched_elsewhere += seen_unwatched.at(i) == expected_unwatched[i] ? 0 : 1;
+  EXPECT_GT(unwatched_elsewhere, 0) << "every member was at every output time: run_filters took no segments";
+  for (std::size_t f = 0; f < filters.size(); ++f) {
+    const FilterScores s = bank.scores(filters[f], grid.steps + 1);
+    EXPECT_TRUE(same_bits(report.scores[f].rmse_truth.value, s.rmse_truth.value)) << filters[f];
+    EXPECT_TRUE(same_bits(report.scores[f].nees.value, s.nees.value)) << filters[f];
+  }
+}
+
+}  // namespace
+}  // namespace kushner
