@@ -14,9 +14,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace kushner {
@@ -156,7 +158,6 @@ TEST(FilterBankSegments, SineWithEveryFilterGivesTheNumbersOfStepsOneAtATime) {
 
 TEST(FilterBankSegments, DivergingMembersAreCountedAsOneStepAtATimeCountsThem) {
   const CubicSensorModel model;
-  std::vector<char> diverged;
   expect_segments_match_steps(model, {"SOF", "SOF-B", "EKF"}, 1e-2, {16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16},
                               {16, 50, 100, 150, 192});
   FilterBank<Space, CubicSensorModel> bank(Space(), model, model, 1100, Seed(20261128), {"SOF"});
