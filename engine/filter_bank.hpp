@@ -191,9 +191,22 @@ class FilterBank {
            static_cast<double>(filters) * (sizeof(double) * n + sizeof(Status));
   }
 
-  /// Whether step_segment may run: a host bank with no estimator stepped beside it.
-  bool steps_in_segments() const {
-    return std::is_same<MemSpace, Kokkos::HostSpace>::value && reference_ == nullptr && estimators_.empty();
+  /// Whether step_segment may run: no estimator steps beside the bank.
+  bool steps_in_segments() const { return reference_ == nullptr && estimators_.empty(); }
+
+  /// A bank in host memory (stepped in chunks of SIMD lanes).
+  static constexpr bool host_bank = Kokkos::SpaceAccessibility<Kokkos::HostSpace, MemSpace>::accessible;
+  /// Whether a run takes segments where it may (run_filters): on the host, where they doubled the bank's rate
+  /// (perf/filter_bank.md); not yet on a GPU, where the team form's first version ran at 34-44% of the rate of a step
+  /// at a time (each thread's copy of the step kernel on its stack; since moved to team scratch, not yet measured).
+  static constexpr bool segments_by_default = host_bank;
+
+  /// Whether step_segment runs its team form (FilterBankTeamSegment: a GPU's) rather than the host's chunk form
+  /// (FilterBankSegment); a device bank runs only the team form. The tests run the team form on the host as well.
+  bool segment_teams() const { return segment_teams_; }
+  void set_segment_teams(bool teams) {
+    KUSHNER_REQUIRE(teams || host_bank, "set_segment_teams: a device bank takes its segments in teams only");
+    segment_teams_ = teams;
   }
 
   /// Steps a segment takes at most (run_filters): 16 steps keep a block's columns in a core's cache for 16 times
@@ -201,7 +214,8 @@ class FilterBank {
   static constexpr int segment_steps = 16;
 
   /// Steps k .. k + outputs.size() - 1 in one pass over blocks of members (temporal blocking:
-  /// kernels/filters/filter_bank_segment.hpp), with the numbers of step() one step at a time (steps_in_segments()).
+  /// kernels/filters/filter_bank_segment.hpp), with the numbers of step() one step at a time (steps_in_segments();
+  /// on a GPU up to the multiply-adds nvcc contracts; at most team_segment_max_steps steps in the team form).
   /// outputs[s] != 0: step k + s ends at an output time. The members `watched` (indices into this bank) take the steps
   /// one at a time first, and after each output step at_output(s) is called with them there: every other member is
   /// then at the segment's start, so at_output may read only the watched ones. Returns snapshots(names) of each output
@@ -434,7 +448,36 @@ class FilterBank {
     std::vector<int> first;  // names[i]'s first column in snapshot_moments_
   };
   mutable PendingSnapshots pending_;
-  std::vector<double> segment_rows_;  // step_segment's block statistics, kept from one segment to the next
+  /// What both forms of step_segment need: per step its output's index (or -1), the snapshot columns of `names`
+  /// (host form: with their places in the sink), their divergence counts, the blocks of the watched members.
+  struct SegmentPlan {
+    std::vector<int> output_of;
+    int num_outputs = 0, last_output = -1;
+    std::vector<SegmentColumn> columns;
+    std::vector<int> first;  // names[i]'s first column
+    NotOkMembers<MemSpace> counted;
+    int num_columns = 0, width = 0, num_blocks = 0;
+    std::vector<int> watched_blocks;  // in increasing order
+  };
+  SegmentPlan plan_segment(const std::vector<char>& outputs, const std::vector<std::string>& names,
+                           const std::vector<long>& watched);
+  /// step_segment's forms: they step the bank and leave each output's merged moments.
+  std::vector<MergedBlocks> step_host_segment(long k, double dt, const SegmentPlan& plan,
+                                              const std::function<void(int)>& at_output);
+  std::vector<MergedBlocks> step_team_segment(long k, double dt, const SegmentPlan& plan,
+                                              const std::function<void(int)>& at_output);
+
+  bool segment_teams_ = !host_bank;
+  std::vector<double> segment_rows_;  // the host form's block statistics, kept from one segment to the next
+  // The team form's buffers, kept from one segment to the next (on a GPU an allocation waits for the device): the
+  // rows (output, block, width), their merged sums (output, width) and a host copy, the teams' blocks (watched
+  // first) and the columns' addresses.
+  Kokkos::View<double*, MemSpace> team_rows_;
+  Kokkos::View<double**, Kokkos::LayoutRight, MemSpace> team_sums_;
+  Kokkos::View<double**, Kokkos::LayoutRight, typename HostStaging<MemSpace>::space> team_sums_host_;
+  Kokkos::View<int*, MemSpace> team_blocks_;
+  std::vector<int> team_block_order_;
+  DeviceAddresses<MemSpace> team_columns_;
 };
 
 template <class ExecSpace, class Model, class TruthModel>
@@ -574,80 +617,196 @@ template <class ExecSpace, class Model, class TruthModel>
 std::vector<std::vector<FilterSnapshot>> FilterBank<ExecSpace, Model, TruthModel>::step_segment(
     const long k, const double dt, const std::vector<char>& outputs, const std::vector<std::string>& names,
     const std::vector<long>& watched, const std::function<void(int)>& at_output) {
-  KUSHNER_REQUIRE(steps_in_segments(), "step_segment: a device bank, or estimators beside the bank");
+  KUSHNER_REQUIRE(steps_in_segments(), "step_segment: estimators step beside the bank");
+  const SegmentPlan plan = plan_segment(outputs, names, watched);
+  const std::vector<MergedBlocks> merged =
+      segment_teams_ ? step_team_segment(k, dt, plan, at_output) : step_host_segment(k, dt, plan, at_output);
   std::vector<std::vector<FilterSnapshot>> result;
-  if constexpr (std::is_same<MemSpace, Kokkos::HostSpace>::value) {
-    using Step = typename K::Step;
-    const int steps = static_cast<int>(outputs.size());
-    std::vector<int> output_of(steps, -1);
-    int num_outputs = 0, last_output = -1;
-    for (int s = 0; s < steps; ++s)
-      if (outputs[s]) {
-        output_of[s] = num_outputs++;
-        last_output = s;
-      }
-    // start_snapshots' columns (no reference here: two per filter) and counts.
-    std::vector<SegmentColumn> columns;
-    std::vector<BankScalar<Status, MemSpace>> statuses;
-    std::vector<int> first;
-    for (const auto& name : names) {
-      bool found = false;
-      for_each_filter_slot(slots_, [&](const auto& slot) {
-        using Filter = decltype(slot.filter);
-        if (!slot.enabled || name != Filter::name) return;
-        found = true;
-        first.push_back(static_cast<int>(columns.size()));
-        const int sink = Step::template fills_sink<Filter>() ? 2 * Step::template slot_index<Filter>() : -1;
-        double* const snapshot = slot.snapshot.data();
-        const std::size_t stride = slot.snapshot.stride(1);
-        columns.push_back({snapshot + snapshot_squared_error * stride, sink});
-        columns.push_back({snapshot + snapshot_nees * stride, sink < 0 ? -1 : sink + 1});
-        statuses.push_back(slot.status);
-      });
-      KUSHNER_REQUIRE(found, "filter '" << name << "' is not in this bank");
+  for (const MergedBlocks& output : merged) result.push_back(snapshots_of(output, names, plan.first));
+  return result;
+}
+
+template <class ExecSpace, class Model, class TruthModel>
+typename FilterBank<ExecSpace, Model, TruthModel>::SegmentPlan FilterBank<ExecSpace, Model, TruthModel>::plan_segment(
+    const std::vector<char>& outputs, const std::vector<std::string>& names, const std::vector<long>& watched) {
+  using Step = typename K::Step;
+  SegmentPlan plan;
+  const int steps = static_cast<int>(outputs.size());
+  plan.output_of.assign(steps, -1);
+  for (int s = 0; s < steps; ++s)
+    if (outputs[s]) {
+      plan.output_of[s] = plan.num_outputs++;
+      plan.last_output = s;
     }
-    const NotOkMembers<MemSpace> counted = diverged_members_(space_, statuses, truth_status_);
-    const int num_columns = static_cast<int>(columns.size()), width = 3 * num_columns + counted.columns();
-    const int num_blocks = static_cast<int>(moment_blocks(members_));
-    const std::size_t output_size = static_cast<std::size_t>(num_blocks) * width;
-    segment_rows_.resize(output_size * num_outputs);
-    std::vector<int> watched_blocks;
-    for (const long member : watched) {
-      KUSHNER_REQUIRE(member >= 0 && member < members_,
-                      "step_segment: watched member " << member << " not in the bank");
-      watched_blocks.push_back(static_cast<int>(member / moment_block_size));
-    }
-    std::sort(watched_blocks.begin(), watched_blocks.end());
-    watched_blocks.erase(std::unique(watched_blocks.begin(), watched_blocks.end()), watched_blocks.end());
-    const FilterBankSegment<Step, NotOkMembers<MemSpace>> segment{step_kernel(k, dt, false),
-                                                                  k,
-                                                                  steps,
-                                                                  dt,
-                                                                  output_of.data(),
-                                                                  last_output,
-                                                                  columns.data(),
-                                                                  num_columns,
-                                                                  counted,
-                                                                  segment_rows_.data(),
-                                                                  num_blocks,
-                                                                  width,
-                                                                  static_cast<int>(members_),
-                                                                  watched_blocks.data(),
-                                                                  static_cast<int>(watched_blocks.size())};
+  // start_snapshots' columns (no reference here: two per filter) and counts.
+  std::vector<BankScalar<Status, MemSpace>> statuses;
+  for (const auto& name : names) {
+    bool found = false;
+    for_each_filter_slot(slots_, [&](const auto& slot) {
+      using Filter = decltype(slot.filter);
+      if (!slot.enabled || name != Filter::name) return;
+      found = true;
+      plan.first.push_back(static_cast<int>(plan.columns.size()));
+      const int sink = Step::template fills_sink<Filter>() ? 2 * Step::template slot_index<Filter>() : -1;
+      double* const snapshot = slot.snapshot.data();
+      const std::size_t stride = slot.snapshot.stride(1);
+      plan.columns.push_back({snapshot + snapshot_squared_error * stride, sink});
+      plan.columns.push_back({snapshot + snapshot_nees * stride, sink < 0 ? -1 : sink + 1});
+      statuses.push_back(slot.status);
+    });
+    KUSHNER_REQUIRE(found, "filter '" << name << "' is not in this bank");
+  }
+  plan.counted = diverged_members_(space_, statuses, truth_status_);
+  plan.num_columns = static_cast<int>(plan.columns.size());
+  plan.width = 3 * plan.num_columns + plan.counted.columns();
+  plan.num_blocks = static_cast<int>(moment_blocks(members_));
+  for (const long member : watched) {
+    KUSHNER_REQUIRE(member >= 0 && member < members_, "step_segment: watched member " << member << " not in the bank");
+    plan.watched_blocks.push_back(static_cast<int>(member / moment_block_size));
+  }
+  std::sort(plan.watched_blocks.begin(), plan.watched_blocks.end());
+  plan.watched_blocks.erase(std::unique(plan.watched_blocks.begin(), plan.watched_blocks.end()),
+                            plan.watched_blocks.end());
+  return plan;
+}
+
+template <class ExecSpace, class Model, class TruthModel>
+std::vector<MergedBlocks> FilterBank<ExecSpace, Model, TruthModel>::step_host_segment(
+    const long k, const double dt, const SegmentPlan& plan, const std::function<void(int)>& at_output) {
+  std::vector<MergedBlocks> merged;
+  if constexpr (host_bank) {
+    const int steps = static_cast<int>(plan.output_of.size());
+    const std::size_t output_size = static_cast<std::size_t>(plan.num_blocks) * plan.width;
+    segment_rows_.resize(output_size * plan.num_outputs);
+    const FilterBankSegment<typename K::Step, NotOkMembers<MemSpace>> segment{
+        step_kernel(k, dt, false),
+        k,
+        steps,
+        dt,
+        plan.output_of.data(),
+        plan.last_output,
+        plan.columns.data(),
+        plan.num_columns,
+        plan.counted,
+        segment_rows_.data(),
+        plan.num_blocks,
+        plan.width,
+        static_cast<int>(members_),
+        plan.watched_blocks.data(),
+        static_cast<int>(plan.watched_blocks.size())};
     space_.fence();
     for (int s = 0; s < steps; ++s) {
-      for (const int b : watched_blocks) segment.run_block(b, s, s + 1);
-      if (outputs[s] && at_output) at_output(s);
+      for (const int b : plan.watched_blocks) segment.run_block(b, s, s + 1);
+      if (plan.output_of[s] >= 0 && at_output) at_output(s);
     }
-    Kokkos::parallel_for("kushner::filter_bank_segment", Kokkos::RangePolicy<ExecSpace>(space_, 0, num_blocks),
+    Kokkos::parallel_for("kushner::filter_bank_segment", Kokkos::RangePolicy<ExecSpace>(space_, 0, plan.num_blocks),
                          segment);
     space_.fence();
-    for (int o = 0; o < num_outputs; ++o)
-      result.push_back(snapshots_of(merge_block_statistics(segment_rows_.data() + o * output_size, output_size,
-                                                           num_columns, counted.columns(), members_),
-                                    names, first));
+    for (int o = 0; o < plan.num_outputs; ++o)
+      merged.push_back(merge_block_statistics(segment_rows_.data() + o * output_size, output_size, plan.num_columns,
+                                              plan.counted.columns(), members_));
   }
-  return result;
+  return merged;
+}
+
+template <class ExecSpace, class Model, class TruthModel>
+std::vector<MergedBlocks> FilterBank<ExecSpace, Model, TruthModel>::step_team_segment(
+    const long k, const double dt, const SegmentPlan& plan, const std::function<void(int)>& at_output) {
+  using Segment = FilterBankTeamSegment<typename K::Step, NotOkMembers<MemSpace>, MemSpace>;
+  const int steps = static_cast<int>(plan.output_of.size());
+  KUSHNER_REQUIRE(steps <= team_segment_max_steps,
+                  "step_segment: " << steps << " steps, more than a segment's " << team_segment_max_steps);
+  const int num_outputs = plan.num_outputs, width = plan.width, num_blocks = plan.num_blocks;
+  const std::size_t output_size = static_cast<std::size_t>(num_blocks) * width;
+  if (team_rows_.extent(0) < output_size * num_outputs)
+    team_rows_ = Kokkos::View<double*, MemSpace>(
+        Kokkos::view_alloc(space_, Kokkos::WithoutInitializing, "kushner::segment_rows"), output_size * num_outputs);
+  // The teams' blocks: the watched ones first (they take the steps one at a time), then the others.
+  std::vector<int> order = plan.watched_blocks;
+  for (int b = 0; b < num_blocks; ++b)
+    if (!std::binary_search(plan.watched_blocks.begin(), plan.watched_blocks.end(), b)) order.push_back(b);
+  if (order != team_block_order_) {
+    team_blocks_ = Kokkos::View<int*, MemSpace>(
+        Kokkos::view_alloc(space_, Kokkos::WithoutInitializing, "kushner::segment_blocks"), order.size());
+    Kokkos::deep_copy(space_, team_blocks_,
+                      Kokkos::View<const int*, Kokkos::HostSpace, Kokkos::MemoryTraits<Kokkos::Unmanaged>>(
+                          order.data(), order.size()));
+    space_.fence();  // the copy reads `order`
+    team_block_order_ = order;
+  }
+  std::vector<std::uintptr_t> addresses;
+  for (const SegmentColumn& column : plan.columns) addresses.push_back(reinterpret_cast<std::uintptr_t>(column.column));
+  Segment segment{step_kernel(k, dt, false),
+                  k,
+                  0,
+                  steps,
+                  dt,
+                  {},
+                  {team_columns_.update(space_, addresses)},
+                  plan.num_columns,
+                  plan.counted,
+                  team_rows_,
+                  num_blocks,
+                  width,
+                  static_cast<int>(members_),
+                  team_blocks_,
+                  0};
+  for (int s = 0; s < team_segment_max_steps; ++s) segment.output_of[s] = s < steps ? plan.output_of[s] : -1;
+  const auto launch = [&](const int first_block, const int blocks) {
+    if (blocks == 0) return;
+    segment.first_team = first_block;
+    const auto scratch = Kokkos::PerTeam(Segment::scratch_bytes(host_bank));
+    if constexpr (host_bank) {  // one thread per team (team_block_statistic's form)
+      Kokkos::parallel_for("kushner::filter_bank_team_segment",
+                           Kokkos::TeamPolicy<ExecSpace>(space_, blocks, 1).set_scratch_size(0, scratch), segment);
+    } else {  // a thread per member, as many as the step's registers let one CUDA block hold, in whole warps
+      auto probe = Kokkos::TeamPolicy<ExecSpace>(space_, blocks, Kokkos::AUTO);
+      probe.set_scratch_size(0, scratch);
+      const int most = probe.team_size_max(segment, Kokkos::ParallelForTag());
+      const int team_size = std::max(moment_lanes, std::min(moment_block_size, most) / moment_lanes * moment_lanes);
+      auto policy = Kokkos::TeamPolicy<ExecSpace>(space_, blocks, team_size);
+      policy.set_scratch_size(0, scratch);
+      Kokkos::parallel_for("kushner::filter_bank_team_segment", policy, segment);
+    }
+  };
+  const int watched = static_cast<int>(plan.watched_blocks.size());
+  for (int s = 0; s < steps && watched > 0; ++s) {
+    segment.s0 = s;
+    segment.s1 = s + 1;
+    launch(0, watched);
+    if (plan.output_of[s] < 0 || !at_output) continue;
+    space_.fence();
+    at_output(s);
+  }
+  segment.s0 = 0;
+  segment.s1 = steps;
+  launch(watched, num_blocks - watched);
+
+  std::vector<MergedBlocks> merged;
+  if (num_outputs == 0) return merged;
+  const int num_counted = plan.counted.columns();
+  if (collective::ranks() > 1) {  // every rank's rows, gathered in rank order (the same branch on every rank)
+    const auto rows = Kokkos::create_mirror_view_and_copy(
+        Kokkos::HostSpace(), Kokkos::subview(team_rows_, std::make_pair(std::size_t(0), output_size * num_outputs)));
+    for (int o = 0; o < num_outputs; ++o)
+      merged.push_back(
+          merge_block_statistics(rows.data() + o * output_size, output_size, plan.num_columns, num_counted, members_));
+    return merged;
+  }
+  if (team_sums_.extent(1) != static_cast<std::size_t>(width)) {  // room for a segment's every step an output
+    team_sums_ = Kokkos::View<double**, Kokkos::LayoutRight, MemSpace>(
+        Kokkos::view_alloc(space_, Kokkos::WithoutInitializing, "kushner::segment_sums"), team_segment_max_steps,
+        width);
+    team_sums_host_ = Kokkos::create_mirror_view(typename HostStaging<MemSpace>::space(), team_sums_);
+  }
+  Kokkos::parallel_for("kushner::merge_block_rows",
+                       Kokkos::RangePolicy<ExecSpace>(space_, 0, num_outputs * (plan.num_columns + num_counted)),
+                       MergeBlockRows<MemSpace>{team_rows_, num_blocks, plan.num_columns, num_counted, team_sums_});
+  if (team_sums_host_.data() != team_sums_.data()) Kokkos::deep_copy(space_, team_sums_host_, team_sums_);
+  space_.fence();
+  for (int o = 0; o < num_outputs; ++o)
+    merged.push_back(merged_blocks(team_sums_host_.data() + o * width, plan.num_columns, num_counted, members_));
+  return merged;
 }
 
 template <class ExecSpace, class Model, class TruthModel>

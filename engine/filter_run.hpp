@@ -46,7 +46,7 @@ struct FilterReport {
 };
 
 /// `observe` is called at t = 0 and at every output time with the bank and the outside estimators (PF, EXACT), e.g.
-/// to record chosen members' trajectories. It may read the global members `members` only: a host run without outside
+/// to record chosen members' trajectories. It may read the global members `members` only: a run without outside
 /// estimators takes several steps at a time (FilterBank::step_segment), and at an output time only those are there.
 template <class ExecSpace, class Model, class TruthModel = Model>
 struct OutputObserver {
@@ -56,8 +56,8 @@ struct OutputObserver {
   std::vector<long> members;
 };
 
-/// Fewest members (of all ranks) for which a host run takes its steps in segments: below it the blocks of
-/// moment_block_size members are too few to share among the threads, and one step at a time costs little.
+/// Fewest members (of all ranks) for which a run takes its steps in segments: below it the blocks of
+/// moment_block_size members are too few to share among a host's threads, and one step at a time costs little.
 constexpr long segment_min_members = 16 * moment_block_size;
 
 /// Estimators a caller adds beside the bank (e.g. `kushner reproduce`'s exact quadrature for a deterministic
@@ -237,9 +237,10 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
   const auto ends_at_output = [&](long step) {
     return next_output < grid.output_steps.size() && grid.output_steps[next_output] == step;
   };
-  // Several steps at a time where nothing steps beside the bank on the host (FilterBank::step_segment); the same on
-  // every rank (the total member count), as every rank must make the same collective calls.
-  const bool segments = bank.steps_in_segments() && share.total >= segment_min_members;
+  // Several steps at a time where nothing steps beside a host bank (FilterBank::step_segment); the same on every
+  // rank (the total member count), as every rank must make the same collective calls.
+  const bool segments = FilterBank<ExecSpace, Model, TruthModel>::segments_by_default && bank.steps_in_segments() &&
+                        share.total >= segment_min_members;
   std::vector<long> watched;  // the observer's members in this rank's bank
   for (const long member : observer.members)
     if (share.holds(member)) watched.push_back(member - share.first);

@@ -400,13 +400,61 @@ struct MergedBlocks {
   std::vector<long> counts;
 };
 
+/// merge_block_statistics' sums over `blocks` rows (BlockStatistics' layout, `width` doubles each, `columns` block
+/// statistics per row) for columns [c0, c1), side by side (each sum runs over the columns of a row at once: 32
+/// independent chains on the host; one column per thread on a device, MergeBlockRows): per column its count, its mean
+/// sum_b n_b mean_b / n, then its m2 = sum_b (m2_b + n_b (mean_b - mean)^2), each sum over the blocks in order;
+/// count[c - c0], mean[c - c0], m2[c - c0]. No division per block (Chan et al.'s pairwise update has two, on the chain
+/// from one block to the next: 115 us for 3907 blocks of 12 columns on the host, a third of a GPU bank's output step).
+KOKKOS_INLINE_FUNCTION void merge_block_columns(const double* rows, const long blocks, const int width,
+                                                const int columns, const int c0, const int c1, double* count,
+                                                double* mean, double* m2) {
+  for (int c = c0; c < c1; ++c) count[c - c0] = mean[c - c0] = m2[c - c0] = 0.0;
+  for (long b = 0; b < blocks; ++b) {
+    const double* row = rows + b * width;
+    for (int c = c0; c < c1; ++c) {
+      count[c - c0] += row[c];
+      mean[c - c0] += row[c] * row[columns + c];  // an empty block's mean is 0
+    }
+  }
+  for (int c = c0; c < c1; ++c) mean[c - c0] /= count[c - c0];
+  for (long b = 0; b < blocks; ++b) {
+    const double* row = rows + b * width;
+    for (int c = c0; c < c1; ++c) {
+      const double delta = row[columns + c] - mean[c - c0];
+      m2[c - c0] += row[c] > 0.0 ? row[2 * columns + c] + row[c] * (delta * delta) : 0.0;
+    }
+  }
+}
+
+/// The counts of counted columns [s0, s1) summed over `blocks` rows (integers: exact), into counts[s - s0].
+KOKKOS_INLINE_FUNCTION void merge_block_counts(const double* rows, const long blocks, const int width,
+                                               const int columns, const int s0, const int s1, double* counts) {
+  for (int s = s0; s < s1; ++s) counts[s - s0] = 0.0;
+  for (long b = 0; b < blocks; ++b)
+    for (int s = s0; s < s1; ++s) counts[s - s0] += rows[b * width + 3 * columns + s];
+}
+
+/// The merged moments of `columns` columns and `counted` counts from their sums (merge_block_columns,
+/// merge_block_counts: sums[c], sums[columns + c], sums[2 columns + c] the count, mean and m2 of column c;
+/// sums[3 columns + s] count s), over `all_members` members of every rank.
+inline MergedBlocks merged_blocks(const double* sums, const int columns, const int counted, const long all_members) {
+  MergedBlocks result;
+  for (int c = 0; c < columns; ++c) {
+    const double count = sums[c], mean = sums[columns + c], m2 = sums[2 * columns + c];
+    result.moments.push_back({{count > 0 ? mean : std::numeric_limits<double>::quiet_NaN()},
+                              {count > 1 ? m2 / (count - 1) : std::numeric_limits<double>::quiet_NaN()},
+                              all_members - static_cast<long>(count),
+                              all_members});
+  }
+  for (int s = 0; s < counted; ++s) result.counts.push_back(static_cast<long>(sums[3 * columns + s]));
+  return result;
+}
+
 /// Every rank's block rows (`local`: this rank's `size` doubles of host rows, `columns` block statistics and
-/// `counted` counts per row: BlockStatistics' layout), merged per column into one EnsembleMoments per column: the
-/// count, the mean sum_b n_b mean_b / n, then m2 = sum_b (m2_b + n_b (mean_b - mean)^2), each sum over the blocks in
-/// order; and the counts summed (integers: exact). The rows of all ranks, in rank order, are the blocks of the whole
-/// ensemble in member order, so the result is the same bits for any number of ranks. No division per block (Chan et
-/// al.'s pairwise update has two, on the chain from one block to the next: 115 us for 3907 blocks of 12 columns on
-/// the host, a third of a GPU bank's output step); each sum runs over the columns side by side.
+/// `counted` counts per row: BlockStatistics' layout), merged per column into one EnsembleMoments per column
+/// (merge_block_columns) and the counts summed. The rows of all ranks, in rank order, are the blocks of the whole
+/// ensemble in member order, so the result is the same bits for any number of ranks.
 inline MergedBlocks merge_block_statistics(const double* local, std::size_t size, int columns, int counted,
                                            long members) {
   const int width = 3 * columns + counted;
@@ -419,33 +467,37 @@ inline MergedBlocks merge_block_statistics(const double* local, std::size_t size
     all_size = gathered.size();
   }
   const long all_blocks = static_cast<long>(all_size) / width;
-  const long all_members = collective::sum(members);
-  std::vector<double> count(columns, 0.0), mean(columns, 0.0), m2(columns, 0.0), counts(counted, 0.0);
-  for (long b = 0; b < all_blocks; ++b) {
-    const double* row = all + b * width;
-    for (int c = 0; c < columns; ++c) {
-      count[c] += row[c];
-      mean[c] += row[c] * row[columns + c];  // an empty block's mean is 0
-    }
-    for (int s = 0; s < counted; ++s) counts[s] += row[3 * columns + s];
-  }
-  for (int c = 0; c < columns; ++c) mean[c] /= count[c];
-  for (long b = 0; b < all_blocks; ++b) {
-    const double* row = all + b * width;
-    for (int c = 0; c < columns; ++c) {
-      const double delta = row[columns + c] - mean[c];
-      m2[c] += row[c] > 0.0 ? row[2 * columns + c] + row[c] * (delta * delta) : 0.0;
-    }
-  }
-  MergedBlocks result;
-  for (int c = 0; c < columns; ++c)
-    result.moments.push_back({{count[c] > 0 ? mean[c] : std::numeric_limits<double>::quiet_NaN()},
-                              {count[c] > 1 ? m2[c] / (count[c] - 1) : std::numeric_limits<double>::quiet_NaN()},
-                              all_members - static_cast<long>(count[c]),
-                              all_members});
-  for (int s = 0; s < counted; ++s) result.counts.push_back(static_cast<long>(counts[s]));
-  return result;
+  std::vector<double> sums(width);
+  merge_block_columns(all, all_blocks, width, columns, 0, columns, sums.data(), sums.data() + columns,
+                      sums.data() + 2 * columns);
+  merge_block_counts(all, all_blocks, width, columns, 0, counted, sums.data() + 3 * columns);
+  return merged_blocks(sums.data(), columns, counted, collective::sum(members));
 }
+
+/// merge_block_statistics of several outputs' rows where they are (one process: no gather), one thread per (output,
+/// column or counted column): rows (output, block, width) of `blocks` blocks, sums (output, width) as
+/// merged_blocks reads them. A GPU bank's segment (FilterBankTeamSegment) leaves up to 32 outputs' rows at once: only
+/// their sums cross the bus, and the host does not merge thousands of rows per output between launches.
+template <class MemSpace>
+struct MergeBlockRows {
+  Kokkos::View<const double*, MemSpace> rows;
+  int blocks, columns, counted;
+  Kokkos::View<double**, Kokkos::LayoutRight, MemSpace> sums;
+
+  KOKKOS_INLINE_FUNCTION void operator()(const int i) const {
+    const int width = 3 * columns + counted, o = i / (columns + counted), c = i % (columns + counted);
+    const double* const r = rows.data() + static_cast<std::size_t>(o) * blocks * width;
+    if (c < columns) {
+      double count, mean, m2;
+      merge_block_columns(r, blocks, width, columns, c, c + 1, &count, &mean, &m2);
+      sums(o, c) = count;
+      sums(o, columns + c) = mean;
+      sums(o, 2 * columns + c) = m2;
+    } else {
+      merge_block_counts(r, blocks, width, columns, c - columns, c - columns + 1, &sums(o, 2 * columns + c));
+    }
+  }
+};
 
 /// Mean and sample variance of every column of x(member, column) over members.
 template <class ExecSpace, class View>

@@ -74,7 +74,8 @@ void BM_FilterBankOutputSteps(benchmark::State& state) {
 }
 
 /// BM_FilterBankOutputSteps' steps taken FilterBank::segment_steps at a time (FilterBank::step_segment, as
-/// engine/filter_run.hpp takes them on the host), members 0 .. 2 watched (the command line's trajectories).
+/// engine/filter_run.hpp takes them: on the host in chunks, on a GPU in teams), members 0 .. 2 watched (the command
+/// line's trajectories: their block takes the steps one at a time first).
 template <class Model>
 void BM_FilterBankSegments(benchmark::State& state) {
   const long members = state.range(0);
@@ -133,6 +134,7 @@ BENCHMARK_TEMPLATE(BM_FilterBankSegments, SineModel)
     ->ArgNames({"members", "output"})
     ->Args({8192, 1})
     ->Args({1000000, 1})
+    ->Args({1000000, 0})
     ->Args({1000000, 0})
     ->UseManualTime();
 BENCHMARK_TEMPLATE(BM_TruthStepAlone, SineModel)

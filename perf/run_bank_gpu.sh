@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
 # The filter bank's GPU figures in two device calls (phases: build, run; issue 16 part 4):
-#   build  build-cuda-bank/: CUDA + Serial, kushner and test_ensemble_moments (16 command units; one 10-minute call
-#          on 16 cores, about 6 minutes on 32)
+#   build  build-cuda-bank/: CUDA + Serial, kushner, test_ensemble_moments, test_filter_bank_segments and
+#          bench_filter_bank (16 command units; about 10 minutes on 16 cores, 6 on 32)
+#   segments  test_filter_bank_segments on the GPU (segments in teams against a step at a time), then
+#          BM_FilterBankOutputSteps (a step at a time) against BM_FilterBankSegments (16 steps per launch), M = 1e6,
+#          in one binary, 3 rounds of 3, with the largest power draw and the SM clocks while they ran
 #   run    test_ensemble_moments on the GPU (the output step's moments and counts against the host's) and
 #          tests/cli/test_filter_determinism.sh (Serial against CUDA); then perf/compare_bank_gpu.sh (kushner CLI vs JAX vs the copy floor, M = 1e6); the same CLI runs with 2 output
 #          points instead of 200 (what an output step costs); Nsight Systems' kernel and API summaries of one run
@@ -36,9 +39,38 @@ if want build; then
   cmake -S "$source_tree" -B "$build" -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON -DKUSHNER_ENABLE_OPENMP=OFF \
     -DKUSHNER_ENABLE_SERIAL=ON -DKUSHNER_ENABLE_MPI=OFF -DKUSHNER_COMMAND_UNITS=16 > "$out/configure.log" 2>&1 ||
     { tail -20 "$out/configure.log"; exit 1; }
-  cmake --build "$build" -j"$(nproc)" --target kushner test_ensemble_moments > "$out/build.log" 2>&1 || status=1
+  { cmake --build "$build" -j"$(nproc)" --target test_filter_bank_segments bench_filter_bank test_ensemble_moments &&
+    cmake --build "$build" -j"$(nproc)" --target kushner; } > "$out/build.log" 2>&1 || status=1
   grep -h -B2 -A10 -m3 " error" "$out/build.log" | head -40
   log "built (status $status)"
+fi
+
+if want segments; then
+  log "test_filter_bank_segments (CUDA: the team form against a step at a time; Serial: the host forms)"
+  "$build/tests/test_filter_bank_segments" > "$out/test_filter_bank_segments.log" 2>&1 || status=1
+  grep -E "^\[  (PASSED|FAILED|SKIPPED)|FAILED \]|SKIPPED \]" "$out/test_filter_bank_segments.log" | tee -a "$out/steps.log"
+  log "BM_FilterBankOutputSteps vs BM_FilterBankSegments, M = 1e6"
+  nvidia-smi --query-gpu=power.draw,clocks.sm --format=csv,noheader,nounits -lms 200 > "$out/segments_power.csv" \
+    2> /dev/null < /dev/null &
+  sampler=$!
+  for round in 1 2 3; do
+    "$build/perf/bench_filter_bank" --benchmark_filter='BM_FilterBank(OutputSteps|Segments).*members:1000000' \
+      --benchmark_repetitions=3 --benchmark_out="$out/segments-$round.json" > /dev/null 2>&1 || status=1
+  done
+  kill "$sampler" 2> /dev/null || true
+  sort -t, -k1 -g "$out/segments_power.csv" | tail -1 | sed 's/^/largest power draw (W), SM clock (MHz): /' |
+    tee -a "$out/steps.log"
+  python3 - "$out" <<'PY' | tee -a "$out/steps.log"
+import collections, glob, json, statistics, sys
+rates = collections.defaultdict(list)
+for path in sorted(glob.glob(sys.argv[1] + "/segments-*.json")):
+    for b in json.load(open(path))["benchmarks"]:
+        if b.get("run_type") == "iteration" and "member_steps_per_s" in b:
+            rates[b["run_name"]].append(b["member_steps_per_s"])
+for name in sorted(rates):
+    print("%s: %.3g member-steps/s (median of %d: %s)" %
+          (name, statistics.median(rates[name]), len(rates[name]), " ".join("%.3g" % r for r in rates[name])))
+PY
 fi
 
 if want run; then

@@ -4,8 +4,9 @@
 // P, status, score sums and snapshot columns) are the same bits. For sine with every filter it supports (lanes that
 // write the block's sink, and EnKBF and ASRE, which step member by member into the snapshot columns), the cubic
 // sensor (SOF loses positive definiteness on some members: the divergence counts), and a discrete-time model. 1100
-// members: four whole blocks of 256 and a short one. Then run_filters, which takes segments on the host from 4096
-// members, against a bank stepped by hand.
+// members: four whole blocks of 256 and a short one. The same for the team form (a GPU's segments), on the host and,
+// where the build has one, on the device. Then run_filters, which takes segments from 4096 members, against a bank
+// stepped by hand.
 #include "engine/filter_run.hpp"
 #include "kernels/filters/filter_list.hpp"
 #include "models/cubic_sensor_model.hpp"
@@ -15,6 +16,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <string>
@@ -26,6 +28,8 @@ namespace {
 
 using Space = Kokkos::DefaultHostExecutionSpace;
 using MemSpace = Space::memory_space;
+using DeviceSpace = Kokkos::DefaultExecutionSpace;
+constexpr bool have_device = !std::is_same<DeviceSpace, Space>::value;
 
 /// a and b are the same bits (NaN equals NaN).
 bool same_bits(double a, double b) {
@@ -35,30 +39,38 @@ bool same_bits(double a, double b) {
   return x == y;
 }
 
+/// The same bits (`relative` 0), or both NaN or within `relative` of each other (a GPU's two kernels: nvcc may contract
+/// multiply-adds differently in each).
+bool matches(double a, double b, double relative) {
+  if (relative == 0.0 || same_bits(a, b)) return same_bits(a, b);
+  if (std::isnan(a) || std::isnan(b)) return false;
+  return std::abs(a - b) <= relative * std::max(std::abs(a), std::abs(b));
+}
+
 void expect_same_snapshots(const std::vector<FilterSnapshot>& steps, const std::vector<FilterSnapshot>& segments,
-                           const std::string& where) {
+                           const std::string& where, double relative = 0.0) {
   ASSERT_EQ(steps.size(), segments.size()) << where;
   for (std::size_t i = 0; i < steps.size(); ++i) {
     const FilterSnapshot &a = steps[i], &b = segments[i];
-    EXPECT_TRUE(same_bits(a.rmse_truth, b.rmse_truth))
+    EXPECT_TRUE(matches(a.rmse_truth, b.rmse_truth, relative))
         << where << " filter " << i << ": " << a.rmse_truth << " vs " << b.rmse_truth;
-    EXPECT_TRUE(same_bits(a.rmse_truth_se, b.rmse_truth_se)) << where << " filter " << i;
-    EXPECT_TRUE(same_bits(a.nees, b.nees)) << where << " filter " << i << ": " << a.nees << " vs " << b.nees;
-    EXPECT_TRUE(same_bits(a.nees_se, b.nees_se)) << where << " filter " << i;
-    EXPECT_TRUE(same_bits(a.rmse_ref, b.rmse_ref)) << where << " filter " << i;
+    EXPECT_TRUE(matches(a.rmse_truth_se, b.rmse_truth_se, relative)) << where << " filter " << i;
+    EXPECT_TRUE(matches(a.nees, b.nees, relative)) << where << " filter " << i << ": " << a.nees << " vs " << b.nees;
+    EXPECT_TRUE(matches(a.nees_se, b.nees_se, relative)) << where << " filter " << i;
+    EXPECT_TRUE(matches(a.rmse_ref, b.rmse_ref, relative)) << where << " filter " << i;
     EXPECT_EQ(a.diverged, b.diverged) << where << " filter " << i;
   }
 }
 
 template <class View>
-void expect_same_view(const View& a, const View& b, const std::string& what) {
+void expect_same_view(const View& a, const View& b, const std::string& what, double relative = 0.0) {
   const auto ha = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), a);
   const auto hb = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), b);
   ASSERT_EQ(ha.span(), hb.span()) << what;
   long differ = 0;
   for (std::size_t i = 0; i < ha.span(); ++i) {
     if constexpr (std::is_same<typename View::non_const_value_type, double>::value)
-      differ += same_bits(ha.data()[i], hb.data()[i]) ? 0 : 1;
+      differ += matches(ha.data()[i], hb.data()[i], relative) ? 0 : 1;
     else
       differ += ha.data()[i] == hb.data()[i] ? 0 : 1;
   }
@@ -70,8 +82,7 @@ template <class Bank>
 std::vector<double> member_values(const Bank& bank, const std::vector<std::string>& filters, long member) {
   std::vector<double> values;
   const auto take = [&](const auto& view) {
-    const auto row =
-        Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), Kokkos::subview(view, member, Kokkos::ALL));
+    const auto row = host_copy(Kokkos::subview(view, member, Kokkos::ALL));
     for (std::size_t i = 0; i < row.extent(0); ++i) values.push_back(row(i));
   };
   take(bank.truths().state());
@@ -80,16 +91,19 @@ std::vector<double> member_values(const Bank& bank, const std::vector<std::strin
 }
 
 /// Steps [0, sum of `segments`) with output steps at the ends of steps `output_ends` (k + 1 for step k), one step at a
-/// time and in segments of the given sizes, members `watched` read at each output time; then everything compared.
-template <class Model>
+/// time and in segments of the given sizes, members `watched` read at each output time; then everything compared:
+/// the same bits on the host (`teams`: the team form of a GPU's segments), within `relative` on a device.
+template <class Model, class BankSpace = Space>
 void expect_segments_match_steps(const Model& model, const std::vector<std::string>& filters, double dt,
-                                 const std::vector<int>& segments, const std::vector<long>& output_ends) {
+                                 const std::vector<int>& segments, const std::vector<long>& output_ends,
+                                 bool teams = false, double relative = 0.0) {
   constexpr long members = 1100;
   const std::vector<long> watched{0, 700};
   const Seed seed(20261128);
-  using Bank = FilterBank<Space, Model>;
-  Bank steps(Space(), model, model, members, seed, filters);
-  Bank segmented(Space(), model, model, members, seed, filters);
+  using Bank = FilterBank<BankSpace, Model>;
+  Bank steps(BankSpace(), model, model, members, seed, filters);
+  Bank segmented(BankSpace(), model, model, members, seed, filters);
+  segmented.set_segment_teams(teams);
   long total = 0;
   for (const int size : segments) total += size;
   const auto is_output = [&](long end) {
@@ -121,31 +135,32 @@ void expect_segments_match_steps(const Model& model, const std::vector<std::stri
   }
   ASSERT_EQ(segment_snapshots.size(), step_snapshots.size());
   for (std::size_t o = 0; o < step_snapshots.size(); ++o)
-    expect_same_snapshots(step_snapshots[o], segment_snapshots[o], "output at step " + std::to_string(output_ends[o]));
+    expect_same_snapshots(step_snapshots[o], segment_snapshots[o], "output at step " + std::to_string(output_ends[o]),
+                          relative);
   ASSERT_EQ(segment_watched.size(), step_watched.size());
   for (std::size_t i = 0; i < step_watched.size(); ++i) {
     ASSERT_EQ(segment_watched[i].size(), step_watched[i].size());
     for (std::size_t j = 0; j < step_watched[i].size(); ++j)
-      EXPECT_TRUE(same_bits(segment_watched[i][j], step_watched[i][j]))
+      EXPECT_TRUE(matches(segment_watched[i][j], step_watched[i][j], relative))
           << "watched member " << watched[i % watched.size()] << " at output " << i / watched.size() << ", value " << j;
   }
 
-  expect_same_view(steps.truths().state(), segmented.truths().state(), "truths");
-  expect_same_view(steps.truths().observations(), segmented.truths().observations(), "observations");
+  expect_same_view(steps.truths().state(), segmented.truths().state(), "truths", relative);
+  expect_same_view(steps.truths().observations(), segmented.truths().observations(), "observations", relative);
   expect_same_view(steps.truth_status(), segmented.truth_status(), "truth status");
   for (const auto& name : filters) {
     steps.with_slot(name, [&](const auto& a) {
       segmented.with_slot(name, [&](const auto& b) {
-        expect_same_view(a.m, b.m, name + " m");
-        expect_same_view(a.P, b.P, name + " P");
+        expect_same_view(a.m, b.m, name + " m", relative);
+        expect_same_view(a.P, b.P, name + " P", relative);
         expect_same_view(a.status, b.status, name + " status");
-        expect_same_view(a.score, b.score, name + " score sums");
-        expect_same_view(a.snapshot, b.snapshot, name + " snapshot columns");
+        expect_same_view(a.score, b.score, name + " score sums", relative);
+        expect_same_view(a.snapshot, b.snapshot, name + " snapshot columns", relative);
       });
     });
     const FilterScores a = steps.scores(name, total + 1), b = segmented.scores(name, total + 1);
-    EXPECT_TRUE(same_bits(a.rmse_truth.value, b.rmse_truth.value)) << name;
-    EXPECT_TRUE(same_bits(a.nees.value, b.nees.value)) << name;
+    EXPECT_TRUE(matches(a.rmse_truth.value, b.rmse_truth.value, relative)) << name;
+    EXPECT_TRUE(matches(a.nees.value, b.nees.value, relative)) << name;
     EXPECT_EQ(a.diverged, b.diverged) << name;
   }
 }
@@ -168,6 +183,35 @@ TEST(FilterBankSegments, DivergingMembersAreCountedAsOneStepAtATimeCountsThem) {
 TEST(FilterBankSegments, DiscreteTimeModelGivesTheNumbersOfStepsOneAtATime) {
   expect_segments_match_steps(LinearDiscreteModel{}, supported_filters(LinearDiscreteModel{}), 1.0, {16, 9},
                               {1, 5, 16, 24});
+}
+
+// The team form (a GPU's segments: FilterBankTeamSegment, its rows merged by MergeBlockRows) run on the host, one
+// thread per team: the same bits as a step at a time.
+TEST(FilterBankSegments, TeamFormGivesTheNumbersOfStepsOneAtATime) {
+  expect_segments_match_steps(SineModel{}, supported_filters(SineModel{}), 1e-2, {16, 3, 16, 5},
+                              {1, 2, 7, 16, 17, 19, 30, 31, 38}, true);
+  expect_segments_match_steps(CubicSensorModel{}, {"SOF", "SOF-B", "EKF"}, 1e-2,
+                              {16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16}, {16, 50, 100, 150, 192}, true);
+  expect_segments_match_steps(LinearDiscreteModel{}, supported_filters(LinearDiscreteModel{}), 1.0, {16, 9},
+                              {1, 5, 16, 24}, true);
+}
+
+// On a GPU (skipped where the default space is the host's): the team form's kernel against the step kernel; each
+// kernel compiled on its own, so equal to rounding.
+TEST(FilterBankSegments, GpuSegmentsGiveTheNumbersOfStepsOneAtATime) {
+  if constexpr (!have_device) {
+    GTEST_SKIP() << "no device execution space in this build";
+  } else {
+    constexpr double relative = 1e-11;
+    expect_segments_match_steps<SineModel, DeviceSpace>(SineModel{}, supported_filters(SineModel{}), 1e-2,
+                                                        {16, 3, 16, 5}, {1, 2, 7, 16, 17, 19, 30, 31, 38}, true,
+                                                        relative);
+    expect_segments_match_steps<CubicSensorModel, DeviceSpace>(CubicSensorModel{}, {"SOF", "SOF-B", "EKF"}, 1e-2,
+                                                               {16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16, 16},
+                                                               {16, 50, 100, 150, 192}, true, relative);
+    expect_segments_match_steps<LinearDiscreteModel, DeviceSpace>(
+        LinearDiscreteModel{}, supported_filters(LinearDiscreteModel{}), 1.0, {16, 9}, {1, 5, 16, 24}, true, relative);
+  }
 }
 
 /// The observer's view of run_filters' watched members, and the report, against a bank stepped one step at a time.

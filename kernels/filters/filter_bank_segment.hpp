@@ -12,8 +12,11 @@
 #include "kernels/for_each_member.hpp"
 #include "kernels/streaming_store.hpp"
 
+#include <Kokkos_Core.hpp>
+
 #include <cstddef>
 #include <cstdint>
+#include <new>
 
 namespace kushner {
 
@@ -94,6 +97,128 @@ struct FilterBankSegment {
             store_streaming(columns[c].column + m, sink[columns[c].sink * moment_block_size + m - begin]);
       streaming_stores_done();
     }
+  }
+};
+
+/// Most steps of a FilterBankTeamSegment launch (its output indices travel in the kernel's arguments).
+constexpr int team_segment_max_steps = 32;
+
+/// A segment on a GPU: one team per block of moment_block_size members (a CUDA block of up to 256 threads, a member
+/// per thread), each block through every step, its columns in the SM's caches from step to step (a step at a time
+/// streamed each member's ~420 bytes from device memory and back at every step). After an output step the team's
+/// warps reduce the block's snapshot columns (written by its own threads, read after a barrier) to its BlockStatistic
+/// rows and divergence counts, as BlockColumnStatistics' warps do after a step at a time; the rows of every output
+/// go to `rows` (output, block, width), merged where they are (MergeBlockRows). On the host (the tests' check of this
+/// form) a team is one thread, which steps its block chunk by chunk (run_member_chunk) and reduces it with
+/// team_block_statistic: the numbers of FilterBankSegment.
+template <class Step, class Counted, class MemSpace>
+struct FilterBankTeamSegment {
+  Step first;  // step first_step's kernel; each step's time, index and output flag are set from it
+  long first_step;
+  int s0, s1;  // the steps this launch takes: first_step + s0 .. first_step + s1 - 1
+  double dt;
+  int output_of[team_segment_max_steps];  // per step of the segment: its output's index, or -1
+  ColumnAddresses<MemSpace> columns;
+  int num_columns;
+  Counted counted;
+  Kokkos::View<double*, MemSpace> rows;
+  int num_blocks, width, members;
+  Kokkos::View<const int*, MemSpace> blocks;  // team i's block: blocks(first_team + i)
+  int first_team;
+
+  template <class Team>
+  KOKKOS_INLINE_FUNCTION void operator()(const Team& team) const {
+    const int b = blocks(first_team + team.league_rank());
+    const int begin = b * moment_block_size, end = block_end(b, members);
+    // The step kernel, one copy per team in its scratch, its time, index and output flag set by the team's first
+    // thread before each step: a copy per thread sat on each thread's stack (3240 bytes of local memory per thread for
+    // sine's bank, by ptxas), and so these segments ran at 34-44% of the rate of a step at a time on an H200.
+    // (get_shmem hands out the team's scratch piece by piece: once per launch.)
+    const std::ptrdiff_t step_bytes = step_scratch_bytes;  // copies: get_shmem takes a reference
+    Step* const step = static_cast<Step*>(team.team_shmem().get_shmem(step_bytes));
+#if KUSHNER_CUDA_DEVICE_PASS
+    double* const scratch = nullptr;  // the warps meet by shuffles
+#else
+    const std::ptrdiff_t bytes = block_team_scratch_bytes;
+    double* const scratch = static_cast<double*>(team.team_shmem().get_shmem(bytes));
+#endif
+    Kokkos::single(Kokkos::PerTeam(team), [&]() { new (step) Step(first); });
+    for (int s = s0; s < s1; ++s) {
+      Kokkos::single(Kokkos::PerTeam(team), [&]() {
+        const long k = first_step + s;
+        step->truth.t = k * dt;  // run_step_kernel's time, bit for bit
+        step->truth.step = static_cast<std::uint32_t>(k);
+        step->record = output_of[s] >= 0;
+      });
+      team.team_barrier();  // the step's fields are set
+      step_block(team, *step, begin, end);
+      team.team_barrier();  // every member took the step (its snapshot values are written) before the fields change
+      if (output_of[s] >= 0)
+        reduce_block(team, rows.data() + (static_cast<std::size_t>(output_of[s]) * num_blocks + b) * width, begin, end,
+                     scratch);
+    }
+    team.team_barrier();
+    Kokkos::single(Kokkos::PerTeam(team), [&]() { step->~Step(); });
+  }
+
+  /// Team scratch of a launch: the team's step kernel, and on the host team_block_statistic's.
+  static constexpr std::size_t step_scratch_bytes = (sizeof(Step) + 7) / 8 * 8;
+  static constexpr std::size_t scratch_bytes(const bool host) {
+    return step_scratch_bytes + (host ? block_team_scratch_bytes : 0);
+  }
+
+ private:
+  template <class Team>
+  KOKKOS_INLINE_FUNCTION void step_block(const Team& team, const Step& step, const int begin, const int end) const {
+#if !KUSHNER_CUDA_DEVICE_PASS
+    if constexpr (Kokkos::SpaceAccessibility<Kokkos::HostSpace, MemSpace>::accessible) {
+      if (team.team_size() == 1) {  // a host team: the step kernel's own chunks (its bits: lanes and vector math)
+        for (int chunk = begin; chunk < end; chunk += host_member_chunk)
+          run_member_chunk(step, chunk, end - chunk < host_member_chunk ? end : chunk + host_member_chunk);
+        return;
+      }
+    }
+#endif
+    for (int m = begin + team.team_rank(); m < end; m += team.team_size()) step(m);
+  }
+
+  template <class Team>
+  KOKKOS_INLINE_FUNCTION void reduce_block(const Team& team, double* row, const int begin, const int end,
+                                           double* scratch) const {
+#if KUSHNER_CUDA_DEVICE_PASS
+    // A column per warp at a time; lane j of a warp adds block_statistic's lane j.
+    const int warps = team.team_size() / moment_lanes, warp = team.team_rank() / moment_lanes;
+    const int j = team.team_rank() % moment_lanes;
+    for (int c = warp; c < num_columns + counted.columns(); c += warps) {
+      if (c < num_columns) {
+        const BlockStatistic s = warp_block_statistic(j, columns(c), begin, end);
+        if (j == 0) {
+          row[c] = s.count;
+          row[num_columns + c] = s.mean;
+          row[2 * num_columns + c] = s.m2;
+        }
+      } else {
+        const int counted_column = c - num_columns;
+        const int count = warp_block_count(
+            j, [&](const int m) { return counted(counted_column, m); }, begin, end);
+        if (j == 0) row[3 * num_columns + counted_column] = count;
+      }
+    }
+#else
+    for (int c = 0; c < num_columns; ++c) {
+      const BlockStatistic s = team_block_statistic(team, columns(c), begin, end, scratch);
+      Kokkos::single(Kokkos::PerTeam(team), [&]() {
+        row[c] = s.count;
+        row[num_columns + c] = s.mean;
+        row[2 * num_columns + c] = s.m2;
+      });
+    }
+    for (int c = 0; c < counted.columns(); ++c) {
+      const int count = team_block_count(
+          team, [&](const int m) { return counted(c, m); }, begin, end);
+      Kokkos::single(Kokkos::PerTeam(team), [&]() { row[3 * num_columns + c] = count; });
+    }
+#endif
   }
 };
 

@@ -79,10 +79,15 @@ struct NotOkMembers {
   Kokkos::View<const std::uintptr_t*, MemSpace> statuses;  // column s at (const Status*) statuses(s)
   BankScalar<Status, MemSpace> truth_status;
 
+  /// A member counts where its truth is ok and its filter's status is not (both read: no branch between the reads,
+  /// warp_block_count).
+  KOKKOS_INLINE_FUNCTION static bool counts(const Status truth, const Status status) {
+    return (truth == Status::ok) & (status != Status::ok);
+  }
+
   KOKKOS_INLINE_FUNCTION int columns() const { return static_cast<int>(statuses.extent(0)); }
   KOKKOS_INLINE_FUNCTION bool operator()(const int s, const int m) const {
-    const Status truth = truth_status(m), status = reinterpret_cast<const Status*>(statuses(s))[m];  // both read:
-    return (truth == Status::ok) & (status != Status::ok);  // no branch between the reads (warp_block_count)
+    return counts(truth_status(m), reinterpret_cast<const Status*>(statuses(s))[m]);
   }
   /// The members m in [begin, end) that count in column s, on the host (FilterBankSegment): one plain loop over the
   /// two byte columns (operator() looks column s up for every member).
@@ -90,7 +95,7 @@ struct NotOkMembers {
     const Status* const status = reinterpret_cast<const Status*>(statuses(s));
     const Status* const truth = truth_status.data();
     int count = 0;
-    for (int m = begin; m < end; ++m) count += (truth[m] == Status::ok) & (status[m] != Status::ok);
+    for (int m = begin; m < end; ++m) count += counts(truth[m], status[m]);
     return count;
   }
 };
