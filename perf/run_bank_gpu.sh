@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # The filter bank's GPU figures in two device calls (phases: build, run; issue 16 part 4):
-#   build  build-cuda-bank/: CUDA + Serial, kushner, test_ensemble_moments, test_filter_bank_segments and
-#          bench_filter_bank (16 command units; about 10 minutes on 16 cores, 6 on 32)
-#   segments  test_filter_bank_segments on the GPU (segments in teams against a step at a time), then
-#          BM_FilterBankOutputSteps (a step at a time) against BM_FilterBankSegments (16 steps per launch), M = 1e6,
-#          in one binary, 3 rounds of 3, with the largest power draw and the SM clocks while they ran
+#   build  build-cuda-bank/: CUDA + Serial, kushner and test_ensemble_moments (16 command units; more than one
+#          10-minute call on 16 cores: the build resumes where the last call stopped; about 6 minutes on 32)
+#   segments  a light build of its own (build-cuda-segments/: test_filter_bank_segments and bench_filter_bank, the
+#          models' shared instances off: only what they use is compiled), test_filter_bank_segments on the GPU
+#          (segments in teams against a step at a time), then BM_FilterBankOutputSteps (a step at a time) against
+#          BM_FilterBankSegments (16 steps per launch), M = 1e6, in one binary, 3 rounds of 3, with the largest power
+#          draw and the SM clock while they ran
 #   run    test_ensemble_moments on the GPU (the output step's moments and counts against the host's) and
 #          tests/cli/test_filter_determinism.sh (Serial against CUDA); then perf/compare_bank_gpu.sh (kushner CLI vs JAX vs the copy floor, M = 1e6); the same CLI runs with 2 output
 #          points instead of 200 (what an output step costs); Nsight Systems' kernel and API summaries of one run
@@ -39,22 +41,33 @@ if want build; then
   cmake -S "$source_tree" -B "$build" -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON -DKUSHNER_ENABLE_OPENMP=OFF \
     -DKUSHNER_ENABLE_SERIAL=ON -DKUSHNER_ENABLE_MPI=OFF -DKUSHNER_COMMAND_UNITS=16 > "$out/configure.log" 2>&1 ||
     { tail -20 "$out/configure.log"; exit 1; }
-  { cmake --build "$build" -j"$(nproc)" --target test_filter_bank_segments bench_filter_bank test_ensemble_moments &&
-    cmake --build "$build" -j"$(nproc)" --target kushner; } > "$out/build.log" 2>&1 || status=1
+  cmake --build "$build" -j"$(nproc)" --target kushner test_ensemble_moments > "$out/build.log" 2>&1 || status=1
   grep -h -B2 -A10 -m3 " error" "$out/build.log" | head -40
   log "built (status $status)"
 fi
 
 if want segments; then
+  # (This session's full build above took more than 9 minutes of 16 cores before these two targets were linked: every
+  # model's shared banks come first.)
+  segments_build=$here/${KUSHNER_SEGMENTS_BUILD:-build-cuda-segments}
+  log "segments: light build"
+  cmake -S "$source_tree" -B "$segments_build" -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON \
+    -DKUSHNER_ENABLE_OPENMP=OFF -DKUSHNER_ENABLE_SERIAL=ON -DKUSHNER_ENABLE_MPI=OFF -DKUSHNER_SHARED_INSTANCES=OFF \
+    > "$out/configure_segments.log" 2>&1 || { tail -20 "$out/configure_segments.log"; exit 1; }
+  # The libraries first: targets built side by side race on their archives.
+  { cmake --build "$segments_build" -j"$(nproc)" --target kokkoscore kokkoscontainers kushner_engine &&
+    cmake --build "$segments_build" -j"$(nproc)" --target test_filter_bank_segments bench_filter_bank; } \
+    > "$out/build_segments.log" 2>&1 || status=1
+  grep -h -B2 -A10 -m3 " error" "$out/build_segments.log" | head -40
   log "test_filter_bank_segments (CUDA: the team form against a step at a time; Serial: the host forms)"
-  "$build/tests/test_filter_bank_segments" > "$out/test_filter_bank_segments.log" 2>&1 || status=1
+  "$segments_build/tests/test_filter_bank_segments" > "$out/test_filter_bank_segments.log" 2>&1 || status=1
   grep -E "^\[  (PASSED|FAILED|SKIPPED)|FAILED \]|SKIPPED \]" "$out/test_filter_bank_segments.log" | tee -a "$out/steps.log"
   log "BM_FilterBankOutputSteps vs BM_FilterBankSegments, M = 1e6"
   nvidia-smi --query-gpu=power.draw,clocks.sm --format=csv,noheader,nounits -lms 200 > "$out/segments_power.csv" \
     2> /dev/null < /dev/null &
   sampler=$!
   for round in 1 2 3; do
-    "$build/perf/bench_filter_bank" --benchmark_filter='BM_FilterBank(OutputSteps|Segments).*members:1000000' \
+    "$segments_build/perf/bench_filter_bank" --benchmark_filter='BM_FilterBank(OutputSteps|Segments).*members:1000000' \
       --benchmark_repetitions=3 --benchmark_out="$out/segments-$round.json" > /dev/null 2>&1 || status=1
   done
   kill "$sampler" 2> /dev/null || true
