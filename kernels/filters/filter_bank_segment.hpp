@@ -134,8 +134,8 @@ struct FilterBankTeamSegment {
     // thread before each step: a copy per thread sat on each thread's stack (3240 bytes of local memory per thread for
     // sine's bank, by ptxas), and so these segments ran at 34-44% of the rate of a step at a time on an H200.
     // (get_shmem hands out the team's scratch piece by piece: once per launch.)
-    const std::ptrdiff_t step_bytes = step_scratch_bytes;  // copies: get_shmem takes a reference
-    Step* const step = static_cast<Step*>(team.team_shmem().get_shmem(step_bytes));
+    const std::ptrdiff_t step_bytes = sizeof(Step);  // copies: get_shmem takes a reference
+    Step* const step = static_cast<Step*>(team.team_shmem().get_shmem_aligned(step_bytes, step_alignment));
 #if KUSHNER_CUDA_DEVICE_PASS
     double* const scratch = nullptr;  // the warps meet by shuffles
 #else
@@ -161,10 +161,11 @@ struct FilterBankTeamSegment {
     Kokkos::single(Kokkos::PerTeam(team), [&]() { step->~Step(); });
   }
 
-  /// Team scratch of a launch: the team's step kernel, and on the host team_block_statistic's.
-  static constexpr std::size_t step_scratch_bytes = (sizeof(Step) + 7) / 8 * 8;
+  /// Team scratch of a launch: the team's step kernel (with room to align it), and on the host team_block_statistic's
+  /// (sizeof(Step) is a multiple of its alignment, at least a double's: the doubles that follow it are aligned).
+  static constexpr std::ptrdiff_t step_alignment = alignof(Step) > 16 ? alignof(Step) : 16;
   static constexpr std::size_t scratch_bytes(const bool host) {
-    return step_scratch_bytes + (host ? block_team_scratch_bytes : 0);
+    return step_alignment + sizeof(Step) + (host ? block_team_scratch_bytes : 0);
   }
 
  private:
