@@ -43,7 +43,7 @@ bool same_bits(double a, double b) {
 /// multiply-adds differently in each).
 bool matches(double a, double b, double relative) {
   if (relative == 0.0 || same_bits(a, b)) return same_bits(a, b);
-  if (std::isnan(a) || std::isnan(b)) return false;
+  if (std::isnan(a) || std::isnan(b)) return std::isnan(a) && std::isnan(b);
   return std::abs(a - b) <= relative * std::max(std::abs(a), std::abs(b));
 }
 
