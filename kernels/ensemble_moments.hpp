@@ -256,12 +256,17 @@ KOKKOS_INLINE_FUNCTION int block_end(const int b, const int members) {
   return b * moment_block_size + moment_block_size < members ? b * moment_block_size + moment_block_size : members;
 }
 
+/// Column c's BlockStatistic in a block's row of `columns` statistics (BlockStatistics' layout).
+KOKKOS_INLINE_FUNCTION void store_block_row(double* row, const int columns, const int c, const BlockStatistic& s) {
+  row[c] = s.count;
+  row[columns + c] = s.mean;
+  row[2 * columns + c] = s.m2;
+}
+
 template <class MemSpace>
 KOKKOS_INLINE_FUNCTION void store_block_statistic(const BlockStatistics<MemSpace>& blocks, const int columns,
                                                   const int b, const int c, const BlockStatistic& s) {
-  blocks(b, c) = s.count;
-  blocks(b, columns + c) = s.mean;
-  blocks(b, 2 * columns + c) = s.m2;
+  store_block_row(&blocks(b, 0), columns, c, s);
 }
 
 /// Column c of x where every column of the member's row is finite, NaN elsewhere: ensemble_moments leaves a

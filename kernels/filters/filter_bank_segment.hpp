@@ -83,10 +83,7 @@ struct FilterBankSegment {
       for (int c = 0; c < num_columns; ++c) {
         const SegmentColumn& column = columns[c];
         const double* const x = column.sink >= 0 ? sink + column.sink * moment_block_size : column.column + begin;
-        const BlockStatistic statistic = block_statistic(BlockValues{x}, 0, end - begin);
-        row[c] = statistic.count;
-        row[num_columns + c] = statistic.mean;
-        row[2 * num_columns + c] = statistic.m2;
+        store_block_row(row, num_columns, c, block_statistic(BlockValues{x}, 0, end - begin));
       }
       for (int c = 0; c < counted.columns(); ++c) row[3 * num_columns + c] = counted.count(c, begin, end);
       if (s != last_output) continue;
@@ -164,9 +161,9 @@ struct FilterBankTeamSegment {
   /// Team scratch of a launch: the team's step kernel (with room to align it), and on the host team_block_statistic's
   /// (sizeof(Step) is a multiple of its alignment, at least a double's: the doubles that follow it are aligned).
   static constexpr std::ptrdiff_t step_alignment = alignof(Step) > 16 ? alignof(Step) : 16;
-  static constexpr std::size_t scratch_bytes(const bool host) {
-    return step_alignment + sizeof(Step) + (host ? block_team_scratch_bytes : 0);
-  }
+  static constexpr std::size_t scratch_bytes =
+      step_alignment + sizeof(Step) +
+      (Kokkos::SpaceAccessibility<Kokkos::HostSpace, MemSpace>::accessible ? block_team_scratch_bytes : 0);
 
  private:
   template <class Team>
@@ -193,11 +190,7 @@ struct FilterBankTeamSegment {
     for (int c = warp; c < num_columns + counted.columns(); c += warps) {
       if (c < num_columns) {
         const BlockStatistic s = warp_block_statistic(j, columns(c), begin, end);
-        if (j == 0) {
-          row[c] = s.count;
-          row[num_columns + c] = s.mean;
-          row[2 * num_columns + c] = s.m2;
-        }
+        if (j == 0) store_block_row(row, num_columns, c, s);
       } else {
         const int counted_column = c - num_columns;
         const int count = warp_block_count(
@@ -208,11 +201,7 @@ struct FilterBankTeamSegment {
 #else
     for (int c = 0; c < num_columns; ++c) {
       const BlockStatistic s = team_block_statistic(team, columns(c), begin, end, scratch);
-      Kokkos::single(Kokkos::PerTeam(team), [&]() {
-        row[c] = s.count;
-        row[num_columns + c] = s.mean;
-        row[2 * num_columns + c] = s.m2;
-      });
+      Kokkos::single(Kokkos::PerTeam(team), [&]() { store_block_row(row, num_columns, c, s); });
     }
     for (int c = 0; c < counted.columns(); ++c) {
       const int count = team_block_count(
