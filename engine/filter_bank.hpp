@@ -461,6 +461,16 @@ class FilterBank {
   };
   SegmentPlan plan_segment(const std::vector<char>& outputs, const std::vector<std::string>& names,
                            const std::vector<long>& watched);
+  /// Each of plan's outputs' rows (host memory: output, block, width) merged over every rank
+  /// (merge_block_statistics; a collective call).
+  std::vector<MergedBlocks> merge_segment_rows(const double* rows, const SegmentPlan& plan) const {
+    const std::size_t output_size = static_cast<std::size_t>(plan.num_blocks) * plan.width;
+    std::vector<MergedBlocks> merged;
+    for (int o = 0; o < plan.num_outputs; ++o)
+      merged.push_back(merge_block_statistics(rows + o * output_size, output_size, plan.num_columns,
+                                              plan.counted.columns(), members_));
+    return merged;
+  }
   /// step_segment's forms: they step the bank and leave each output's merged moments.
   std::vector<MergedBlocks> step_host_segment(long k, double dt, const SegmentPlan& plan,
                                               const std::function<void(int)>& at_output);
@@ -702,9 +712,7 @@ std::vector<MergedBlocks> FilterBank<ExecSpace, Model, TruthModel>::step_host_se
     Kokkos::parallel_for("kushner::filter_bank_segment", Kokkos::RangePolicy<ExecSpace>(space_, 0, plan.num_blocks),
                          segment);
     space_.fence();
-    for (int o = 0; o < plan.num_outputs; ++o)
-      merged.push_back(merge_block_statistics(segment_rows_.data() + o * output_size, output_size, plan.num_columns,
-                                              plan.counted.columns(), members_));
+    merged = merge_segment_rows(segment_rows_.data(), plan);
   }
   return merged;
 }
@@ -755,7 +763,7 @@ std::vector<MergedBlocks> FilterBank<ExecSpace, Model, TruthModel>::step_team_se
   const auto launch = [&](const int first_block, const int blocks) {
     if (blocks == 0) return;
     segment.first_team = first_block;
-    const auto scratch = Kokkos::PerTeam(Segment::scratch_bytes(host_bank));
+    const auto scratch = Kokkos::PerTeam(Segment::scratch_bytes);
     if constexpr (host_bank) {  // one thread per team (team_block_statistic's form)
       Kokkos::parallel_for("kushner::filter_bank_team_segment",
                            Kokkos::TeamPolicy<ExecSpace>(space_, blocks, 1).set_scratch_size(0, scratch), segment);
@@ -788,10 +796,7 @@ std::vector<MergedBlocks> FilterBank<ExecSpace, Model, TruthModel>::step_team_se
   if (collective::ranks() > 1) {  // every rank's rows, gathered in rank order (the same branch on every rank)
     const auto rows = Kokkos::create_mirror_view_and_copy(
         Kokkos::HostSpace(), Kokkos::subview(team_rows_, std::make_pair(std::size_t(0), output_size * num_outputs)));
-    for (int o = 0; o < num_outputs; ++o)
-      merged.push_back(
-          merge_block_statistics(rows.data() + o * output_size, output_size, plan.num_columns, num_counted, members_));
-    return merged;
+    return merge_segment_rows(rows.data(), plan);
   }
   if (team_sums_.extent(1) != static_cast<std::size_t>(width)) {  // room for a segment's every step an output
     team_sums_ = Kokkos::View<double**, Kokkos::LayoutRight, MemSpace>(
