@@ -804,9 +804,8 @@ std::vector<MergedBlocks> FilterBank<ExecSpace, Model, TruthModel>::step_team_se
         width);
     team_sums_host_ = Kokkos::create_mirror_view(typename HostStaging<MemSpace>::space(), team_sums_);
   }
-  Kokkos::parallel_for("kushner::merge_block_rows",
-                       Kokkos::RangePolicy<ExecSpace>(space_, 0, num_outputs * (plan.num_columns + num_counted)),
-                       MergeBlockRows<MemSpace>{team_rows_, num_blocks, plan.num_columns, num_counted, team_sums_});
+  merge_block_rows(space_, MergeBlockRows<MemSpace>{team_rows_, num_blocks, plan.num_columns, num_counted, team_sums_},
+                   num_outputs);
   if (team_sums_host_.data() != team_sums_.data()) Kokkos::deep_copy(space_, team_sums_host_, team_sums_);
   space_.fence();
   for (int o = 0; o < num_outputs; ++o)

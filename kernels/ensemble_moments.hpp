@@ -108,6 +108,19 @@ __device__ inline double warp_pairwise_sum(double x) {
   return __shfl_sync(0xffffffffu, x, 0);
 }
 
+/// The BlockStatistic of a warp whose lane holds `count` and `sum` of its values and whose squared deviations from a
+/// mean are `deviations(mean)`: the lanes meet by warp_pairwise_sum (every lane returns it).
+template <class Deviations>
+__device__ BlockStatistic warp_statistic(const double count, const double sum, const Deviations& deviations) {
+  BlockStatistic s;
+  s.count = warp_pairwise_sum(count);
+  const double total = warp_pairwise_sum(sum);  // every lane takes part in a shuffle
+  if (s.count == 0.0) return s;
+  s.mean = total / s.count;
+  s.m2 = warp_pairwise_sum(deviations(s.mean));
+  return s;
+}
+
 /// block_statistic by the 32 lanes of a warp, lane j this thread (each lane adds the values of block_statistic's
 /// lane j): the same sums in the same order, so the same bits up to the multiply-adds nvcc contracts. Each lane
 /// loads its (up to) moment_lane_members values at once and keeps them in registers for the second pass; the lanes
@@ -129,19 +142,15 @@ __device__ BlockStatistic warp_block_statistic(const int j, const Value& value, 
     count += finite ? 1.0 : 0.0;
     sum += finite ? v[k] : 0.0;
   }
-  BlockStatistic s;
-  s.count = warp_pairwise_sum(count);
-  const double total = warp_pairwise_sum(sum);  // every lane takes part in a shuffle
-  if (s.count == 0.0) return s;
-  s.mean = total / s.count;
-  double ss = 0.0;
-  KUSHNER_DEVICE_UNROLL
-  for (int k = 0; k < K; ++k) {
-    const double d = math::is_finite(v[k]) ? v[k] - s.mean : 0.0;
-    ss += d * d;
-  }
-  s.m2 = warp_pairwise_sum(ss);
-  return s;
+  return warp_statistic(count, sum, [&](const double mean) {
+    double ss = 0.0;
+    KUSHNER_DEVICE_UNROLL
+    for (int k = 0; k < K; ++k) {
+      const double d = math::is_finite(v[k]) ? v[k] - mean : 0.0;
+      ss += d * d;
+    }
+    return ss;
+  });
 }
 
 /// The members m in [begin, end) with counted(m), by the 32 lanes of a warp (lane j this thread, its members as in
@@ -405,44 +414,97 @@ struct MergedBlocks {
   std::vector<long> counts;
 };
 
-/// merge_block_statistics' sums over `blocks` rows (BlockStatistics' layout, `width` doubles each, `columns` block
-/// statistics per row) for columns [c0, c1), side by side (each sum runs over the columns of a row at once: 32
-/// independent chains on the host; one column per thread on a device, MergeBlockRows): per column its count, its mean
-/// sum_b n_b mean_b / n, then its m2 = sum_b (m2_b + n_b (mean_b - mean)^2), each sum over the blocks in order;
-/// count[c - c0], mean[c - c0], m2[c - c0]. No division per block (Chan et al.'s pairwise update has two, on the chain
-/// from one block to the next: 115 us for 3907 blocks of 12 columns on the host, a third of a GPU bank's output step).
+/// The BlockStatistic of columns c0 .. c0 + G - 1 over `blocks` rows (BlockStatistics' layout, `width` doubles each,
+/// `columns` block statistics per row), into merged[0 .. G): per column its count, its mean sum_b n_b mean_b / n, then
+/// its m2 = sum_b (m2_b + n_b (mean_b - mean)^2). Block b adds into lane b % moment_lanes, in block order, and the
+/// lanes are added by pairwise_sum, as block_statistic adds members: independent chains, no division per block (Chan et
+/// al.'s pairwise update has two on the chain from one block to the next: 115 us for 3907 blocks of 12 columns on the
+/// host), and the order of warp_merge_block_column, so a GPU's merge gives the same bits (up to the multiply-adds it
+/// contracts). G columns side by side (contiguous in a row: vector lanes on the host): 8 columns of 3907 blocks took 31
+/// us here with G = 8, 100 us a column at a time (one chain per column, block after block: 28 us).
+template <int G>
 KOKKOS_INLINE_FUNCTION void merge_block_columns(const double* rows, const long blocks, const int width,
-                                                const int columns, const int c0, const int c1, double* count,
-                                                double* mean, double* m2) {
-  for (int c = c0; c < c1; ++c) count[c - c0] = mean[c - c0] = m2[c - c0] = 0.0;
-  for (long b = 0; b < blocks; ++b) {
-    const double* row = rows + b * width;
-    for (int c = c0; c < c1; ++c) {
-      count[c - c0] += row[c];
-      mean[c - c0] += row[c] * row[columns + c];  // an empty block's mean is 0
+                                                const int columns, const int c0, BlockStatistic* merged) {
+  constexpr int L = moment_lanes;
+  double count[L][G], sum[L][G], ss[L][G];
+  for (int j = 0; j < L; ++j)
+    for (int g = 0; g < G; ++g) count[j][g] = sum[j][g] = ss[j][g] = 0.0;
+  const long whole = blocks - blocks % L;  // the lanes' full rounds, then the rest: a fixed trip count unrolls
+  for (long b0 = 0; b0 < blocks; b0 += L) {
+    const int n = b0 < whole ? L : static_cast<int>(blocks - whole);
+    for (int j = 0; j < n; ++j) {
+      const double* const row = rows + (b0 + j) * width + c0;
+      for (int g = 0; g < G; ++g) {
+        count[j][g] += row[g];
+        sum[j][g] += row[g] * row[columns + g];  // an empty block's mean is 0
+      }
     }
   }
-  for (int c = c0; c < c1; ++c) mean[c - c0] /= count[c - c0];
-  for (long b = 0; b < blocks; ++b) {
-    const double* row = rows + b * width;
-    for (int c = c0; c < c1; ++c) {
-      const double delta = row[columns + c] - mean[c - c0];
-      m2[c - c0] += row[c] > 0.0 ? row[2 * columns + c] + row[c] * (delta * delta) : 0.0;
+  double lanes[L];
+  for (int g = 0; g < G; ++g) {
+    for (int j = 0; j < L; ++j) lanes[j] = count[j][g];
+    merged[g].count = pairwise_sum<L>(lanes);
+    for (int j = 0; j < L; ++j) lanes[j] = sum[j][g];
+    merged[g].mean = merged[g].count == 0.0 ? 0.0 : pairwise_sum<L>(lanes) / merged[g].count;
+  }
+  for (long b0 = 0; b0 < blocks; b0 += L) {
+    const int n = b0 < whole ? L : static_cast<int>(blocks - whole);
+    for (int j = 0; j < n; ++j) {
+      const double* const row = rows + (b0 + j) * width + c0;
+      for (int g = 0; g < G; ++g) {
+        const double delta = row[columns + g] - merged[g].mean;
+        ss[j][g] += row[g] > 0.0 ? row[2 * columns + g] + row[g] * (delta * delta) : 0.0;
+      }
     }
+  }
+  for (int g = 0; g < G; ++g) {
+    for (int j = 0; j < L; ++j) lanes[j] = ss[j][g];
+    merged[g].m2 = pairwise_sum<L>(lanes);
   }
 }
 
-/// The counts of counted columns [s0, s1) summed over `blocks` rows (integers: exact), into counts[s - s0].
-KOKKOS_INLINE_FUNCTION void merge_block_counts(const double* rows, const long blocks, const int width,
-                                               const int columns, const int s0, const int s1, double* counts) {
-  for (int s = s0; s < s1; ++s) counts[s - s0] = 0.0;
-  for (long b = 0; b < blocks; ++b)
-    for (int s = s0; s < s1; ++s) counts[s - s0] += rows[b * width + 3 * columns + s];
+/// Counted column s's count summed over `blocks` rows (integers: any order gives the same sum).
+KOKKOS_INLINE_FUNCTION double merge_block_count(const double* rows, const long blocks, const int width,
+                                                const int columns, const int s) {
+  double count = 0.0;
+  for (long b = 0; b < blocks; ++b) count += rows[b * width + 3 * columns + s];
+  return count;
 }
 
-/// The merged moments of `columns` columns and `counted` counts from their sums (merge_block_columns,
-/// merge_block_counts: sums[c], sums[columns + c], sums[2 columns + c] the count, mean and m2 of column c;
-/// sums[3 columns + s] count s), over `all_members` members of every rank.
+#if KUSHNER_CUDA_DEVICE_PASS
+/// Column c's merge_block_columns by the 32 lanes of a warp (lane j this thread adds merge_block_columns' lane j);
+/// every lane returns it.
+__device__ inline BlockStatistic warp_merge_block_column(const int j, const double* rows, const long blocks,
+                                                         const int width, const int columns, const int c) {
+  double count = 0.0, sum = 0.0;
+  for (long b = j; b < blocks; b += moment_lanes) {
+    const double* const row = rows + b * width;
+    count += row[c];
+    sum += row[c] * row[columns + c];
+  }
+  return warp_statistic(count, sum, [&](const double mean) {
+    double ss = 0.0;
+    for (long b = j; b < blocks; b += moment_lanes) {
+      const double* const row = rows + b * width;
+      const double delta = row[columns + c] - mean;
+      ss += row[c] > 0.0 ? row[2 * columns + c] + row[c] * (delta * delta) : 0.0;
+    }
+    return ss;
+  });
+}
+
+/// merge_block_count by the 32 lanes of a warp; every lane returns it.
+__device__ inline double warp_merge_block_count(const int j, const double* rows, const long blocks, const int width,
+                                                const int columns, const int s) {
+  double count = 0.0;
+  for (long b = j; b < blocks; b += moment_lanes) count += rows[b * width + 3 * columns + s];
+  return warp_pairwise_sum(count);
+}
+#endif
+
+/// The merged moments of `columns` columns and `counted` counts from their sums (a row in BlockStatistics' layout:
+/// merge_block_columns' count, mean and m2 of column c at c, columns + c, 2 columns + c; merge_block_count's count s
+/// at 3 columns + s), over `all_members` members of every rank.
 inline MergedBlocks merged_blocks(const double* sums, const int columns, const int counted, const long all_members) {
   MergedBlocks result;
   for (int c = 0; c < columns; ++c) {
@@ -454,6 +516,19 @@ inline MergedBlocks merged_blocks(const double* sums, const int columns, const i
   }
   for (int s = 0; s < counted; ++s) result.counts.push_back(static_cast<long>(sums[3 * columns + s]));
   return result;
+}
+
+/// merge_block_columns<G> over columns c, c + G, ... while G columns are left, into sums (a row in BlockStatistics'
+/// layout); returns the first column left. Groups of 8, then 4, then 1 give every column the same sums.
+template <int G>
+int merge_column_groups(const double* rows, const long blocks, const int width, const int columns, int c,
+                        double* sums) {
+  BlockStatistic merged[G];
+  for (; c + G <= columns; c += G) {
+    merge_block_columns<G>(rows, blocks, width, columns, c, merged);
+    for (int g = 0; g < G; ++g) store_block_row(sums, columns, c + g, merged[g]);
+  }
+  return c;
 }
 
 /// Every rank's block rows (`local`: this rank's `size` doubles of host rows, `columns` block statistics and
@@ -473,16 +548,21 @@ inline MergedBlocks merge_block_statistics(const double* local, std::size_t size
   }
   const long all_blocks = static_cast<long>(all_size) / width;
   std::vector<double> sums(width);
-  merge_block_columns(all, all_blocks, width, columns, 0, columns, sums.data(), sums.data() + columns,
-                      sums.data() + 2 * columns);
-  merge_block_counts(all, all_blocks, width, columns, 0, counted, sums.data() + 3 * columns);
+  int c = merge_column_groups<8>(all, all_blocks, width, columns, 0, sums.data());
+  c = merge_column_groups<4>(all, all_blocks, width, columns, c, sums.data());
+  merge_column_groups<1>(all, all_blocks, width, columns, c, sums.data());
+  for (int s = 0; s < counted; ++s) sums[3 * columns + s] = merge_block_count(all, all_blocks, width, columns, s);
   return merged_blocks(sums.data(), columns, counted, collective::sum(members));
 }
 
-/// merge_block_statistics of several outputs' rows where they are (one process: no gather), one thread per (output,
-/// column or counted column): rows (output, block, width) of `blocks` blocks, sums (output, width) as
-/// merged_blocks reads them. A GPU bank's segment (FilterBankTeamSegment) leaves up to 32 outputs' rows at once: only
-/// their sums cross the bus, and the host does not merge thousands of rows per output between launches.
+/// merge_block_statistics of several outputs' rows where they are (one process: no gather), a (output, column or
+/// counted column) pair i = o (columns + counted) + c each: rows (output, block, width) of `blocks` blocks, sums
+/// (output, width) as merged_blocks reads them. A GPU bank's segment (FilterBankTeamSegment) leaves up to 32 outputs'
+/// rows at once: only their sums cross the bus, and the host does not merge thousands of rows per output between
+/// launches. Two forms, the same bits: a thread per pair (operator()(i), the host's), or a warp per pair (a team of
+/// moment_lanes threads, operator()(BlockTeams, team), on a GPU; a thread per pair there, 3907 blocks one after another
+/// in each of 192 threads for 16 outputs of 12 columns and 4 counts, took 4.4 ms per segment on an H200, more than the
+/// segment's 16 steps).
 template <class MemSpace>
 struct MergeBlockRows {
   Kokkos::View<const double*, MemSpace> rows;
@@ -493,16 +573,44 @@ struct MergeBlockRows {
     const int width = 3 * columns + counted, o = i / (columns + counted), c = i % (columns + counted);
     const double* const r = rows.data() + static_cast<std::size_t>(o) * blocks * width;
     if (c < columns) {
-      double count, mean, m2;
-      merge_block_columns(r, blocks, width, columns, c, c + 1, &count, &mean, &m2);
-      sums(o, c) = count;
-      sums(o, columns + c) = mean;
-      sums(o, 2 * columns + c) = m2;
+      BlockStatistic merged;
+      merge_block_columns<1>(r, blocks, width, columns, c, &merged);
+      store_block_row(&sums(o, 0), columns, c, merged);
+    } else
+      sums(o, 2 * columns + c) = merge_block_count(r, blocks, width, columns, c - columns);
+  }
+
+  template <class Team>
+  KOKKOS_INLINE_FUNCTION void operator()(BlockTeams, const Team& team) const {
+#if KUSHNER_CUDA_DEVICE_PASS
+    const int i = team.league_rank(), j = team.team_rank();
+    const int width = 3 * columns + counted, o = i / (columns + counted), c = i % (columns + counted);
+    const double* const r = rows.data() + static_cast<std::size_t>(o) * blocks * width;
+    if (c < columns) {
+      const BlockStatistic s = warp_merge_block_column(j, r, blocks, width, columns, c);
+      if (j == 0) store_block_row(&sums(o, 0), columns, c, s);
     } else {
-      merge_block_counts(r, blocks, width, columns, c - columns, c - columns + 1, &sums(o, 2 * columns + c));
+      const double count = warp_merge_block_count(j, r, blocks, width, columns, c - columns);
+      if (j == 0) sums(o, 2 * columns + c) = count;
     }
+#else
+    (void)team;  // the host takes operator()(i)
+#endif
   }
 };
+
+/// Launches `merge` over the pairs of its first `outputs` outputs: a warp per pair on a GPU, a thread per pair on the
+/// host.
+template <class ExecSpace>
+void merge_block_rows(const ExecSpace& space, const MergeBlockRows<typename ExecSpace::memory_space>& merge,
+                      const int outputs) {
+  const int pairs = outputs * (merge.columns + merge.counted);
+  if constexpr (block_teams_by_default<typename ExecSpace::memory_space>)
+    Kokkos::parallel_for("kushner::merge_block_rows",
+                         Kokkos::TeamPolicy<ExecSpace, BlockTeams>(space, pairs, moment_lanes), merge);
+  else
+    Kokkos::parallel_for("kushner::merge_block_rows", Kokkos::RangePolicy<ExecSpace>(space, 0, pairs), merge);
+}
 
 /// Mean and sample variance of every column of x(member, column) over members.
 template <class ExecSpace, class View>

@@ -73,13 +73,14 @@ void BM_FilterBankOutputSteps(benchmark::State& state) {
     if (bank.scores(name, k + 1).diverged > 0) state.SkipWithError(("diverged members in " + name).c_str());
 }
 
-/// BM_FilterBankOutputSteps' steps taken FilterBank::segment_steps at a time (FilterBank::step_segment, as
-/// engine/filter_run.hpp takes them: on the host in chunks, on a GPU in teams), members 0 .. 2 watched (the command
-/// line's trajectories: their block takes the steps one at a time first).
+/// BM_FilterBankOutputSteps' steps taken FilterBank::segment_steps at a time (FilterBank::step_segment: on the host in
+/// chunks, as engine/filter_run.hpp takes them; on a GPU in teams). Arg 2 = 1: members 0 .. 2 watched (`compare`'s
+/// traced members: their block takes the steps one at a time first); 0: none (`kushner filter`).
 template <class Model>
 void BM_FilterBankSegments(benchmark::State& state) {
   const long members = state.range(0);
   const bool output = state.range(1) != 0;
+  const std::vector<long> watched = state.range(2) != 0 ? std::vector<long>{0, 1, 2} : std::vector<long>{};
   const Space space;
   const std::vector<std::string> filters{"EKF", "SOF", "QLF", "KBL"};
   using Bank = FilterBank<Space, Model>;
@@ -88,7 +89,7 @@ void BM_FilterBankSegments(benchmark::State& state) {
   long k = 0;
   for (auto _ : state) {
     Kokkos::Timer timer;
-    bank.step_segment(k, 1e-3, outputs, filters, {0, 1, 2});
+    bank.step_segment(k, 1e-3, outputs, filters, watched);
     k += Bank::segment_steps;
     state.SetIterationTime(timer.seconds());
   }
@@ -131,11 +132,12 @@ BENCHMARK_TEMPLATE(BM_FilterBankOutputSteps, SineModel)
     ->Args({1000000, 0})
     ->UseManualTime();
 BENCHMARK_TEMPLATE(BM_FilterBankSegments, SineModel)
-    ->ArgNames({"members", "output"})
-    ->Args({8192, 1})
-    ->Args({1000000, 1})
-    ->Args({1000000, 0})
-    ->Args({1000000, 0})
+    ->ArgNames({"members", "output", "watched"})
+    ->Args({8192, 1, 1})
+    ->Args({1000000, 1, 1})
+    ->Args({1000000, 0, 1})
+    ->Args({1000000, 1, 0})
+    ->Args({1000000, 0, 0})
     ->UseManualTime();
 BENCHMARK_TEMPLATE(BM_TruthStepAlone, SineModel)
     ->ArgName("members")

@@ -2,11 +2,12 @@
 # The filter bank's GPU figures in two device calls (phases: build, run; issue 16 part 4):
 #   build  build-cuda-bank/: CUDA + Serial, kushner and test_ensemble_moments (16 command units; more than one
 #          10-minute call on 16 cores: the build resumes where the last call stopped; about 6 minutes on 32)
-#   segments  a light build of its own (build-cuda-segments/: test_filter_bank_segments and bench_filter_bank, the
-#          models' shared instances off: only what they use is compiled), test_filter_bank_segments on the GPU
-#          (segments in teams against a step at a time), then BM_FilterBankOutputSteps (a step at a time) against
-#          BM_FilterBankSegments (16 steps per launch), M = 1e6, in one binary, 3 rounds of 3, with the largest power
-#          draw and the SM clock while they ran
+#   segments  a light build of its own (build-cuda-segments/: test_filter_bank_segments, test_ensemble_moments and
+#          bench_filter_bank, the models' shared instances off: only what they use is compiled; about 4.5 minutes on
+#          16 cores), test_filter_bank_segments on the GPU (segments in teams against a step at a time) and
+#          test_ensemble_moments, then BM_FilterBankOutputSteps (a step at a time) against BM_FilterBankSegments (16
+#          steps per launch, with and without watched members), M = 1e6, in one binary, KUSHNER_SEGMENT_ROUNDS (3)
+#          rounds of 3, with the largest power draw and the SM clock while they ran
 #   run    test_ensemble_moments on the GPU (the output step's moments and counts against the host's) and
 #          tests/cli/test_filter_determinism.sh (Serial against CUDA); then perf/compare_bank_gpu.sh (kushner CLI vs JAX vs the copy floor, M = 1e6); the same CLI runs with 2 output
 #          points instead of 200 (what an output step costs); Nsight Systems' kernel and API summaries of one run
@@ -56,17 +57,21 @@ if want segments; then
     > "$out/configure_segments.log" 2>&1 || { tail -20 "$out/configure_segments.log"; exit 1; }
   # The libraries first: targets built side by side race on their archives.
   { cmake --build "$segments_build" -j"$(nproc)" --target kokkoscore kokkoscontainers kushner_engine &&
-    cmake --build "$segments_build" -j"$(nproc)" --target test_filter_bank_segments bench_filter_bank; } \
+    cmake --build "$segments_build" -j"$(nproc)" --target test_filter_bank_segments test_ensemble_moments \
+      bench_filter_bank; } \
     > "$out/build_segments.log" 2>&1 || status=1
   grep -h -B2 -A10 -m3 " error" "$out/build_segments.log" | head -40
   log "test_filter_bank_segments (CUDA: the team form against a step at a time; Serial: the host forms)"
   "$segments_build/tests/test_filter_bank_segments" > "$out/test_filter_bank_segments.log" 2>&1 || status=1
   grep -E "^\[  (PASSED|FAILED|SKIPPED)|FAILED \]|SKIPPED \]" "$out/test_filter_bank_segments.log" | tee -a "$out/steps.log"
+  log "test_ensemble_moments (CUDA: the merge of a segment's rows, a warp per column, against the host's; Serial)"
+  "$segments_build/tests/test_ensemble_moments" > "$out/test_ensemble_moments.log" 2>&1 || status=1
+  grep -E "^\[  (PASSED|FAILED)|FAILED \]" "$out/test_ensemble_moments.log" | tee -a "$out/steps.log"
   log "BM_FilterBankOutputSteps vs BM_FilterBankSegments, M = 1e6"
   nvidia-smi --query-gpu=power.draw,clocks.sm --format=csv,noheader,nounits -lms 200 > "$out/segments_power.csv" \
     2> /dev/null < /dev/null &
   sampler=$!
-  for round in 1 2 3; do
+  for round in $(seq "${KUSHNER_SEGMENT_ROUNDS:-3}"); do
     "$segments_build/perf/bench_filter_bank" --benchmark_filter='BM_FilterBank(OutputSteps|Segments).*members:1000000' \
       --benchmark_repetitions=3 --benchmark_out="$out/segments-$round.json" > /dev/null 2>&1 || status=1
   done
@@ -147,7 +152,7 @@ if want ab; then
   log "ab: built"
   "$here/build-cuda-ab-new/tests/test_ensemble_moments" > "$out/ab_test_ensemble_moments.log" 2>&1 || status=1
   grep -E "^\[  (PASSED|FAILED)|FAILED \]" "$out/ab_test_ensemble_moments.log" | tee -a "$out/steps.log"
-  for round in 1 2 3; do
+  for round in $(seq "${KUSHNER_SEGMENT_ROUNDS:-3}"); do
     for which in old new; do
       "$here/build-cuda-ab-$which/perf/bench_filter_bank" --benchmark_filter=BM_FilterBankOutputSteps \
         --benchmark_repetitions=3 --benchmark_out="$out/ab-$which-$round.json" > /dev/null 2>&1 || status=1

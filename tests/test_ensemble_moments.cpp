@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <vector>
 
 namespace kushner {
 namespace {
@@ -186,6 +187,100 @@ TYPED_TEST(EnsembleMomentsTest, DivergenceCountsInTheMomentsLaunchEqualTheStatus
     }
     moments.start(TypeParam(), {column}, diverged(TypeParam(), {b_d}, truth_d));
     EXPECT_EQ(moments.finish().counts, std::vector<long>{expected_b}) << "teams " << teams;
+  }
+}
+
+/// Block rows (BlockStatistics' layout) of `outputs` outputs of `blocks` blocks, `columns` columns, `counted` counts:
+/// full, short and empty blocks, means around 1e3 (pooling must not lose their digits).
+std::vector<double> sample_block_rows(int outputs, int blocks, int columns, int counted) {
+  const int width = 3 * columns + counted;
+  std::vector<double> rows(static_cast<std::size_t>(outputs) * blocks * width);
+  for (int o = 0; o < outputs; ++o)
+    for (int b = 0; b < blocks; ++b) {
+      double* row = rows.data() + (static_cast<std::size_t>(o) * blocks + b) * width;
+      for (int c = 0; c < columns; ++c) {
+        const int n = (b + c) % 97 == 5 ? 0 : (b * 7 + c + o) % 61 == 2 ? 1 : (b + o) % 53 == 0 ? 100 : 256;
+        row[c] = n;
+        row[columns + c] = n == 0 ? 0.0 : 1e3 + std::sin(0.3 * b + c + o);  // an empty block's mean is 0
+        row[2 * columns + c] = n <= 1 ? 0.0 : (n - 1) * (1.0 + 0.5 * std::cos(0.7 * b - c));
+      }
+      for (int s = 0; s < counted; ++s) row[3 * columns + s] = (b * 3 + o) % 5 * (s + 1);
+    }
+  return rows;
+}
+
+/// The merge of block rows (merge_block_statistics: the host's, of every rank's rows; 1000 blocks: 31 rounds of the 32
+/// lanes and 8 more; 13 columns: merged in groups of 8, 4 and 1): the pooled count, mean and m2 of each column (the
+/// pooled formulas in long double, 1e-13), the counts exactly, and the same bits for a column merged alone.
+/// MergeBlockRows (a segment's merge where its rows are, two outputs at once: a warp per pair on a GPU) gives the same
+/// bits on the host and agrees to 1e-13 on a GPU.
+TYPED_TEST(EnsembleMomentsTest, MergedBlockRowsArePooledMoments) {
+  using MemSpace = typename TypeParam::memory_space;
+  const int outputs = 2, blocks = 1000, columns = 13, counted = 2, width = 3 * columns + counted;
+  const std::vector<double> rows = sample_block_rows(outputs, blocks, columns, counted);
+  const std::size_t output_size = static_cast<std::size_t>(blocks) * width;
+  const long members = 256L * blocks;
+  std::vector<MergedBlocks> host;
+  for (int o = 0; o < outputs; ++o) {
+    const double* r = rows.data() + o * output_size;
+    host.push_back(merge_block_statistics(r, output_size, columns, counted, members));
+    const MergedBlocks& merged = host.back();
+    std::vector<double> alone(width);
+    for (int c = 0; c < columns; ++c) {
+      BlockStatistic s;
+      merge_block_columns<1>(r, blocks, width, columns, c, &s);
+      store_block_row(alone.data(), columns, c, s);
+      long double n = 0, weighted = 0;
+      for (int b = 0; b < blocks; ++b) {
+        n += r[b * width + c];
+        weighted += static_cast<long double>(r[b * width + c]) * r[b * width + columns + c];
+      }
+      const long double mean = weighted / n;
+      long double m2 = 0;
+      for (int b = 0; b < blocks; ++b) {
+        const long double delta = r[b * width + columns + c] - mean;
+        if (r[b * width + c] > 0) m2 += r[b * width + 2 * columns + c] + r[b * width + c] * delta * delta;
+      }
+      const EnsembleMoments& mo = merged.moments[c];
+      EXPECT_EQ(mo.members - mo.non_finite, static_cast<long>(n)) << "column " << c;
+      EXPECT_NEAR(mo.mean[0], static_cast<double>(mean), 1e-13 * 1e3) << "column " << c;
+      EXPECT_NEAR(mo.variance[0], static_cast<double>(m2 / (n - 1)), 1e-13 * static_cast<double>(m2 / (n - 1)))
+          << "column " << c;
+    }
+    for (int s = 0; s < counted; ++s) {
+      long expected = 0;
+      for (int b = 0; b < blocks; ++b) expected += static_cast<long>(r[b * width + 3 * columns + s]);
+      EXPECT_EQ(merged.counts[s], expected) << "count " << s;
+      alone[3 * columns + s] = merge_block_count(r, blocks, width, columns, s);
+    }
+    const MergedBlocks one_at_a_time = merged_blocks(alone.data(), columns, counted, members);
+    for (int c = 0; c < columns; ++c) {
+      EXPECT_EQ(one_at_a_time.moments[c].mean, merged.moments[c].mean) << "column " << c;
+      EXPECT_EQ(one_at_a_time.moments[c].variance, merged.moments[c].variance) << "column " << c;
+    }
+  }
+
+  Kokkos::View<double*, MemSpace> rows_d("rows", rows.size());
+  Kokkos::deep_copy(rows_d, Kokkos::View<const double*, Kokkos::HostSpace, Kokkos::MemoryTraits<Kokkos::Unmanaged>>(
+                                rows.data(), rows.size()));
+  Kokkos::View<double**, Kokkos::LayoutRight, MemSpace> sums("sums", outputs, width);
+  merge_block_rows(TypeParam(), MergeBlockRows<MemSpace>{rows_d, blocks, columns, counted, sums}, outputs);
+  const auto sums_h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sums);
+  const bool on_host = Kokkos::SpaceAccessibility<Kokkos::HostSpace, MemSpace>::accessible;
+  for (int o = 0; o < outputs; ++o) {
+    const MergedBlocks where = merged_blocks(&sums_h(o, 0), columns, counted, members);
+    EXPECT_EQ(where.counts, host[o].counts) << "output " << o;
+    for (int c = 0; c < columns; ++c) {
+      const EnsembleMoments &a = where.moments[c], &b = host[o].moments[c];
+      EXPECT_EQ(a.non_finite, b.non_finite) << "output " << o << " column " << c;
+      if (on_host) {
+        EXPECT_EQ(a.mean, b.mean) << "output " << o << " column " << c;
+        EXPECT_EQ(a.variance, b.variance) << "output " << o << " column " << c;
+      } else {
+        EXPECT_NEAR(a.mean[0], b.mean[0], 1e-13 * std::abs(b.mean[0])) << "output " << o << " column " << c;
+        EXPECT_NEAR(a.variance[0], b.variance[0], 1e-13 * b.variance[0]) << "output " << o << " column " << c;
+      }
+    }
   }
 }
 
