@@ -35,7 +35,8 @@ nvidia-smi --query-gpu=name,memory.total,power.limit,clocks.max.sm,driver_versio
 build_tree() {  # build_tree SRC BUILD TARGETS...
   local src=$1 dir=$2; shift 2
   local name; name=$(basename "$dir")
-  cmake -S "$src" -B "$dir" -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON -DKUSHNER_ENABLE_OPENMP=OFF \
+  cmake -C "$here/perf/gpu_machine.cmake" -S "$src" -B "$dir" \
+    -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON -DKUSHNER_ENABLE_OPENMP=OFF \
     -DKUSHNER_CUDA_ARCH="$arch" ${KUSHNER_CMAKE_ARGS:-} > "$out/configure_$name.log" 2>&1 || return 1
   cmake --build "$dir" -j"$jobs" --target kushner_engine kushner_test_main kushner_bench_main > "$out/build_$name.log" 2>&1 ||
     return 1

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The filter bank's GPU figures in two device calls (phases: build, run; issue 16 part 4):
-#   build  build-cuda-bank/: CUDA + Serial, kushner and test_ensemble_moments (16 command units; more than one
-#          10-minute call on 16 cores: the build resumes where the last call stopped; about 6 minutes on 32)
+#   build  build-cuda-bank/: CUDA + Serial, kushner and test_ensemble_moments (perf/gpu_machine.cmake: sm_90 only,
+#          a unit per model; before it, three calls on 32 cores (570, 560, 520 s) did not finish it: a unit of 4
+#          models compiled for more than 520 s alone; the build resumes where the last call stopped)
 #   segments  a light build of its own (build-cuda-segments/: test_filter_bank_segments, test_ensemble_moments and
 #          bench_filter_bank, the models' shared instances off: only what they use is compiled; on 16 cores 4.3 minutes
 #          for the first two built one after another), test_filter_bank_segments on the GPU (segments in teams against a step at a time) and
@@ -39,8 +40,9 @@ nvidia-smi --query-gpu=name,memory.total,power.limit,clocks.max.sm,driver_versio
 
 if want build; then
   log "configure"
-  cmake -S "$source_tree" -B "$build" -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON -DKUSHNER_ENABLE_OPENMP=OFF \
-    -DKUSHNER_ENABLE_SERIAL=ON -DKUSHNER_ENABLE_MPI=OFF -DKUSHNER_COMMAND_UNITS=16 > "$out/configure.log" 2>&1 ||
+  cmake -C "$here/perf/gpu_machine.cmake" -S "$source_tree" -B "$build" \
+    -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON -DKUSHNER_ENABLE_OPENMP=OFF \
+    -DKUSHNER_ENABLE_SERIAL=ON -DKUSHNER_ENABLE_MPI=OFF > "$out/configure.log" 2>&1 ||
     { tail -20 "$out/configure.log"; exit 1; }
   cmake --build "$build" -j"$(nproc)" --target kushner test_ensemble_moments > "$out/build.log" 2>&1 || status=1
   grep -h -B2 -A10 -m3 " error" "$out/build.log" | head -40
@@ -52,7 +54,8 @@ if want segments; then
   # model's shared banks come first.)
   segments_build=$here/${KUSHNER_SEGMENTS_BUILD:-build-cuda-segments}
   log "segments: light build"
-  cmake -S "$source_tree" -B "$segments_build" -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON \
+  cmake -C "$here/perf/gpu_machine.cmake" -S "$source_tree" -B "$segments_build" \
+    -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON \
     -DKUSHNER_ENABLE_OPENMP=OFF -DKUSHNER_ENABLE_SERIAL=ON -DKUSHNER_ENABLE_MPI=OFF -DKUSHNER_SHARED_INSTANCES=OFF \
     > "$out/configure_segments.log" 2>&1 || { tail -20 "$out/configure_segments.log"; exit 1; }
   # The libraries first: targets built side by side race on their archives. Then the three programs side by side,
@@ -147,7 +150,8 @@ if want ab; then
   cp "$here/perf/bench_filter_bank.cpp" "$old_tree/perf/bench_filter_bank.cpp"
   light() {  # light SRC BUILD TARGETS...
     local src=$1 dir=$2; shift 2
-    cmake -S "$src" -B "$dir" -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON -DKUSHNER_ENABLE_OPENMP=OFF \
+    cmake -C "$here/perf/gpu_machine.cmake" -S "$src" -B "$dir" \
+      -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON -DKUSHNER_ENABLE_OPENMP=OFF \
       -DKUSHNER_ENABLE_SERIAL=ON -DKUSHNER_ENABLE_MPI=OFF -DKUSHNER_SHARED_INSTANCES=OFF > "$out/configure_$(basename "$dir").log" 2>&1 &&
       cmake --build "$dir" -j16 --target "$@" > "$out/build_$(basename "$dir").log" 2>&1
   }

@@ -18,7 +18,8 @@ nvidia-smi --query-gpu=name,memory.total,power.limit,clocks.max.sm,driver_versio
 
 if want build; then
   log "configure"
-  cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON -DKUSHNER_ENABLE_OPENMP=ON \
+  cmake -C "$here/perf/gpu_machine.cmake" -S "$here" -B "$build" \
+    -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON -DKUSHNER_ENABLE_OPENMP=ON \
     > "$out/configure.log" 2>&1 || { tail -20 "$out/configure.log"; exit 1; }
   log "common libraries"
   cmake --build "$build" -j16 --target kushner_test_main kushner_bench_main kushner_driver > "$out/build_common.log" 2>&1 ||

@@ -24,8 +24,9 @@ nvidia-smi --query-gpu=name,memory.total,power.limit,clocks.max.sm,driver_versio
 
 if want build; then
   log "configure"
-  cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON -DKUSHNER_ENABLE_OPENMP=ON \
-    -DKUSHNER_ENABLE_SERIAL=ON -DKUSHNER_ENABLE_MPI=OFF -DKUSHNER_COMMAND_UNITS=16 > "$out/configure.log" 2>&1 || { tail -20 "$out/configure.log"; exit 1; }
+  cmake -C "$here/perf/gpu_machine.cmake" -S "$here" -B "$build" \
+    -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON -DKUSHNER_ENABLE_OPENMP=ON \
+    -DKUSHNER_ENABLE_SERIAL=ON -DKUSHNER_ENABLE_MPI=OFF > "$out/configure.log" 2>&1 || { tail -20 "$out/configure.log"; exit 1; }
   log "common libraries"
   cmake --build "$build" -j16 --target kushner_test_main kushner_driver > "$out/build_common.log" 2>&1 ||
     { grep -B2 -A10 -m3 "error" "$out/build_common.log"; exit 1; }

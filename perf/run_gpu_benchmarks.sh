@@ -51,7 +51,8 @@ nvidia-smi --query-gpu=name,memory.total,clocks.max.sm,clocks.max.mem,driver_ver
 git -C "$here" describe --always --dirty --abbrev=12 > "$out/git.txt" 2>&1
 
 if want build; then
-run configure cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON \
+run configure cmake -C "$here/perf/gpu_machine.cmake" -S "$here" -B "$build" \
+  -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON \
   -DKUSHNER_ENABLE_OPENMP=OFF -DKUSHNER_ENABLE_THRUST=ON -DKUSHNER_CUDA_ARCH="$arch" || { echo "configure failed"; exit 1; }
 run build cmake --build "$build" -j"$jobs" --target test_resampling test_particle_filter \
   test_particle_filter_references test_grid_filter test_particle_snapshot test_particle_random test_filter_consistency \

@@ -41,7 +41,8 @@ cat "$work/gpu.txt"
 
 if ! want build && [ ! -x "$build/kushner" ]; then phases="$phases build "; fi
 if want build; then
-  step configure cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON \
+  step configure cmake -C "$here/perf/gpu_machine.cmake" -S "$here" -B "$build" \
+    -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON \
     -DKUSHNER_ENABLE_OPENMP=ON -DKUSHNER_ENABLE_THRUST=ON || { cat "$work/configure.log"; exit 1; }
   step build cmake --build "$build" -j16 || { grep -B2 -A12 -m3 "error" "$work/build.log"; exit 1; }
 fi

@@ -30,10 +30,10 @@ cat "$out/gpu.csv" "$out/mpirun.txt"
 
 if want build; then
   log "configure"
-  # The models' banks and commands spread over more units than the default: the GPU machines have 16-32 cores.
-  cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON -DKUSHNER_ENABLE_OPENMP=ON \
+  # perf/gpu_machine.cmake: the models' banks and commands spread over more units than the default (16-32 cores).
+  cmake -C "$here/perf/gpu_machine.cmake" -S "$here" -B "$build" \
+    -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON -DKUSHNER_ENABLE_OPENMP=ON \
     -DKUSHNER_ENABLE_MPI=ON -DKUSHNER_ENABLE_TESTS=OFF -DKUSHNER_ENABLE_BENCHMARKS=OFF \
-    -DKUSHNER_INSTANCE_UNITS=16 -DKUSHNER_COMMAND_UNITS=8 \
     > "$out/configure.log" 2>&1 || { tail -20 "$out/configure.log"; exit 1; }
   grep "mpi=" "$out/configure.log"
   log "build kushner"

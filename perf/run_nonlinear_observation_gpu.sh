@@ -26,7 +26,8 @@ step() {  # step NAME CMD...: output to NAME.log, time and exit code to steps.lo
 nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv,noheader | tee "$out/gpu.txt"
 git -C "$here" describe --always --dirty --abbrev=12 > "$out/git.txt" 2>&1
 if [ ! -x "$build/kushner" ]; then
-  step configure cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON \
+  step configure cmake -C "$here/perf/gpu_machine.cmake" -S "$here" -B "$build" \
+    -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON \
     -DKUSHNER_ENABLE_OPENMP=ON -DKUSHNER_ENABLE_THRUST=ON -DKUSHNER_ENABLE_TESTS=OFF \
     -DKUSHNER_ENABLE_BENCHMARKS=OFF || { tail -30 "$out/configure.log"; exit 1; }
 fi
