@@ -414,6 +414,16 @@ struct MergedBlocks {
   std::vector<long> counts;
 };
 
+/// A block row's terms in the merged moments of its column c (BlockStatistics' layout: counts n_b, then means, then
+/// m2s): n_b mean_b in the mean's sum (an empty block's mean is 0), and m2_b + n_b (mean_b - mean)^2 in the m2's.
+KOKKOS_INLINE_FUNCTION double block_row_sum(const double* row, const int columns, const int c) {
+  return row[c] * row[columns + c];
+}
+KOKKOS_INLINE_FUNCTION double block_row_spread(const double* row, const int columns, const int c, const double mean) {
+  const double delta = row[columns + c] - mean;
+  return row[c] > 0.0 ? row[2 * columns + c] + row[c] * (delta * delta) : 0.0;
+}
+
 /// The BlockStatistic of columns c0 .. c0 + G - 1 over `blocks` rows (BlockStatistics' layout, `width` doubles each,
 /// `columns` block statistics per row), into merged[0 .. G): per column its count, its mean sum_b n_b mean_b / n, then
 /// its m2 = sum_b (m2_b + n_b (mean_b - mean)^2). Block b adds into lane b % moment_lanes, in block order, and the
@@ -436,7 +446,7 @@ KOKKOS_INLINE_FUNCTION void merge_block_columns(const double* rows, const long b
       const double* const row = rows + (b0 + j) * width + c0;
       for (int g = 0; g < G; ++g) {
         count[j][g] += row[g];
-        sum[j][g] += row[g] * row[columns + g];  // an empty block's mean is 0
+        sum[j][g] += block_row_sum(row, columns, g);
       }
     }
   }
@@ -451,10 +461,7 @@ KOKKOS_INLINE_FUNCTION void merge_block_columns(const double* rows, const long b
     const int n = b0 < whole ? L : static_cast<int>(blocks - whole);
     for (int j = 0; j < n; ++j) {
       const double* const row = rows + (b0 + j) * width + c0;
-      for (int g = 0; g < G; ++g) {
-        const double delta = row[columns + g] - merged[g].mean;
-        ss[j][g] += row[g] > 0.0 ? row[2 * columns + g] + row[g] * (delta * delta) : 0.0;
-      }
+      for (int g = 0; g < G; ++g) ss[j][g] += block_row_spread(row, columns, g, merged[g].mean);
     }
   }
   for (int g = 0; g < G; ++g) {
@@ -480,15 +487,11 @@ __device__ inline BlockStatistic warp_merge_block_column(const int j, const doub
   for (long b = j; b < blocks; b += moment_lanes) {
     const double* const row = rows + b * width;
     count += row[c];
-    sum += row[c] * row[columns + c];
+    sum += block_row_sum(row, columns, c);
   }
   return warp_statistic(count, sum, [&](const double mean) {
     double ss = 0.0;
-    for (long b = j; b < blocks; b += moment_lanes) {
-      const double* const row = rows + b * width;
-      const double delta = row[columns + c] - mean;
-      ss += row[c] > 0.0 ? row[2 * columns + c] + row[c] * (delta * delta) : 0.0;
-    }
+    for (long b = j; b < blocks; b += moment_lanes) ss += block_row_spread(rows + b * width, columns, c, mean);
     return ss;
   });
 }
