@@ -196,11 +196,6 @@ class FilterBank {
 
   /// A bank in host memory (stepped in chunks of SIMD lanes).
   static constexpr bool host_bank = Kokkos::SpaceAccessibility<Kokkos::HostSpace, MemSpace>::accessible;
-  /// Whether a run takes segments where it may (run_filters): on the host, where they doubled the bank's rate
-  /// (perf/filter_bank.md); not yet on a GPU, where the team form's first version ran at 34-44% of the rate of a step
-  /// at a time (each thread's copy of the step kernel on its stack; since moved to team scratch, not yet measured).
-  static constexpr bool segments_by_default = host_bank;
-
   /// Whether step_segment runs its team form (FilterBankTeamSegment: a GPU's) rather than the host's chunk form
   /// (FilterBankSegment); a device bank runs only the team form. The tests run the team form on the host as well.
   bool segment_teams() const { return segment_teams_; }
@@ -768,11 +763,14 @@ std::vector<MergedBlocks> FilterBank<ExecSpace, Model, TruthModel>::step_team_se
       Kokkos::parallel_for("kushner::filter_bank_team_segment",
                            Kokkos::TeamPolicy<ExecSpace>(space_, blocks, 1).set_scratch_size(0, scratch), segment);
     } else {  // a thread per member, as many as the step's registers let one CUDA block hold, in whole warps
-      auto probe = Kokkos::TeamPolicy<ExecSpace>(space_, blocks, Kokkos::AUTO);
+      // Bounds of 3 blocks of 256 per SM (80 registers on sm_90, some spilled, where the step took 120-128 and 2
+      // blocks fit) gave 1.14-1.27x the segments' rate on an H200 (perf/filter_bank.md); 4 blocks spilled more.
+      using Policy = Kokkos::TeamPolicy<ExecSpace, Kokkos::LaunchBounds<moment_block_size, 3>>;
+      auto probe = Policy(space_, blocks, Kokkos::AUTO);
       probe.set_scratch_size(0, scratch);
       const int most = probe.team_size_max(segment, Kokkos::ParallelForTag());
       const int team_size = std::max(moment_lanes, std::min(moment_block_size, most) / moment_lanes * moment_lanes);
-      auto policy = Kokkos::TeamPolicy<ExecSpace>(space_, blocks, team_size);
+      auto policy = Policy(space_, blocks, team_size);
       policy.set_scratch_size(0, scratch);
       Kokkos::parallel_for("kushner::filter_bank_team_segment", policy, segment);
     }

@@ -237,10 +237,10 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
   const auto ends_at_output = [&](long step) {
     return next_output < grid.output_steps.size() && grid.output_steps[next_output] == step;
   };
-  // Several steps at a time where nothing steps beside a host bank (FilterBank::step_segment); the same on every
-  // rank (the total member count), as every rank must make the same collective calls.
-  const bool segments = FilterBank<ExecSpace, Model, TruthModel>::segments_by_default && bank.steps_in_segments() &&
-                        share.total >= segment_min_members;
+  // Several steps at a time where nothing steps beside the bank (FilterBank::step_segment): on the host they doubled
+  // the bank's rate, on a GPU 1.7-1.8x (perf/filter_bank.md). The same on every rank (the total member count), as
+  // every rank must make the same collective calls.
+  const bool segments = bank.steps_in_segments() && share.total >= segment_min_members;
   std::vector<long> watched;  // the observer's members in this rank's bank
   for (const long member : observer.members)
     if (share.holds(member)) watched.push_back(member - share.first);

@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # The filter bank's GPU figures in two device calls (phases: build, run; issue 16 part 4):
 #   build  build-cuda-bank/: CUDA + Serial, kushner and test_ensemble_moments (perf/gpu_machine.cmake: sm_90 only,
-#          a unit per model; before it, three calls on 32 cores (570, 560, 520 s) did not finish it: a unit of 4
-#          models compiled for more than 520 s alone; the build resumes where the last call stopped)
+#          a unit per model: 374 s on 32 cores from nothing; before it, three calls on 32 cores (570, 560, 520 s) did
+#          not finish it; the build resumes where the last call stopped)
+#          The run phase after it takes more than the rest of a 10-minute call (test_filter_determinism.sh alone
+#          190 s): give each phase a call of its own, back to back while the machine stays warm.
 #   segments  a light build of its own (build-cuda-segments/: test_filter_bank_segments, test_ensemble_moments and
 #          bench_filter_bank, the models' shared instances off: only what they use is compiled; on 16 cores 4.3 minutes
 #          for the first two built one after another), test_filter_bank_segments on the GPU (segments in teams against a step at a time) and

@@ -88,9 +88,8 @@ PY
 }
 
 compare_runs sine --model sine --filters all --members 2000 --T 1 --dt 1e-2 --seed 7 --output-points 20
-# 4096 members and more take segments of 16 steps (run_filters): the host's chunk form on Serial and OpenMP (on a GPU,
-# the team form once FilterBank::segments_by_default takes them there); output steps every 5 of the 50 steps fall
-# inside segments and at the end of the last, short one.
+# 4096 members and more take segments of 16 steps (run_filters): the host's chunk form on Serial and OpenMP, the team
+# form on a GPU; output steps every 5 of the 50 steps fall inside segments and at the end of the last, short one.
 compare_runs sine-segments --model sine --filters EKF,SOF,QLF,KBL --members 5000 --T 0.5 --dt 1e-2 --seed 13 \
   --output-points 10
 compare_runs cubic --model cubic-oscillator --filters all --members 1001 --T 0.5 --dt 5e-3 --seed 8 --output-points 10
