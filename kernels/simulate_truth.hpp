@@ -53,6 +53,14 @@ void initialize_gaussian(const ExecSpace& space, const BankVector<MemSpace>& x, 
                        GaussianInitialize<N, MemSpace>{x, mean, root, key});
 }
 
+/// A truth's step of one member (at the truth's own t and step) from the state its bank holds: Truth::step_from.
+template <class Model, class Truth>
+KOKKOS_INLINE_FUNCTION void step_stored_state(const Truth& truth, const int member, const typename Model::Control& u) {
+  Vec<Model::state_dim> next;
+  Vec<Model::obs_dim> increment;
+  truth.step_from(member, truth.t, truth.step, u, load<Model::state_dim>(truth.x, member), next, increment);
+}
+
 /// One Euler-Maruyama step of every member over [t, t + dt]:
 ///   dy = h(t, x) dt + R dv,   x <- x + f(t, x, u) dt + G(t, x) dw,   dw, dv ~ N(0, dt I),
 /// with u = 0 (open loop) or, in a closed loop, the member's control (step_member). The draws depend on seed,
@@ -70,42 +78,41 @@ struct EulerMaruyamaTruthStep {
 
   /// The step of one member driven by the control u over it (a closed loop's, kernels/control/).
   KOKKOS_INLINE_FUNCTION void step_member(const int member, const typename Model::Control& u) const {
-    constexpr int n = Model::state_dim, p = Model::obs_dim;
-    Vec<n> next;
-    Vec<p> increment;
-    next_state<Random123Draws>(member, u, load<n>(x, member), next, increment);
+    step_stored_state<Model>(*this, member, u);
+  }
+
+  /// step_member as step k at time `at` (the fields t and step in a step at a time; a GPU's segment passes each of
+  /// its steps' and leaves the kernel as it is) from x(at) = xm, read by the caller (the bank reads it with the
+  /// truth's status: one wait for memory); stores and returns x(at + dt) and dy.
+  KOKKOS_INLINE_FUNCTION void step_from(const int member, const double at, const std::uint32_t k,
+                                        const typename Model::Control& u, const Vec<Model::state_dim>& xm,
+                                        Vec<Model::state_dim>& next, Vec<Model::obs_dim>& increment) const {
+    constexpr int p = Model::obs_dim, q = Model::noise_dim;
+    Vec<p> zv = Vec<p>::zero();
+    if constexpr (!has_deterministic_observation_noise<Model>)
+      zv = normals<p, Random123Draws>(RngKey{seed, Stream::observation_noise}, member, k);
+    advance_state(at, u, xm, normals<q, Random123Draws>(RngKey{seed, Stream::process_noise}, member, k), zv, next,
+                  increment);
     store(dy, member, increment);
     store(x, member, next);
   }
 
-  /// The step from x(t) = xm without storing it: x(t + dt) and dy. `Draws` says where the uniforms come from
-  /// (Random123Draws, SimdDraws: the same bits, kernels/particle_filter/particle_draws.hpp).
-  template <class Draws>
-  KOKKOS_INLINE_FUNCTION void next_state(const int member, const typename Model::Control& u,
-                                         const Vec<Model::state_dim>& xm, Vec<Model::state_dim>& next,
-                                         Vec<Model::obs_dim>& increment) const {
-    constexpr int p = Model::obs_dim, q = Model::noise_dim;
-    Vec<p> zv = Vec<p>::zero();
-    if constexpr (!has_deterministic_observation_noise<Model>)
-      zv = normals<p, Draws>(RngKey{seed, Stream::observation_noise}, member, step);
-    advance_state(u, xm, normals<q, Draws>(RngKey{seed, Stream::process_noise}, member, step), zv, next, increment);
-  }
-
-  /// The step from x(t) = xm with the standard normals zw (process noise) and zv (observation noise; unused where
+  /// The step from x(at) = xm with the standard normals zw (process noise) and zv (observation noise; unused where
   /// the model's observation noise is a given path).
-  KOKKOS_INLINE_FUNCTION void advance_state(const typename Model::Control& u, const Vec<Model::state_dim>& xm,
-                                            const Vec<Model::noise_dim>& zw, const Vec<Model::obs_dim>& zv,
-                                            Vec<Model::state_dim>& next, Vec<Model::obs_dim>& increment) const {
+  KOKKOS_INLINE_FUNCTION void advance_state(const double at, const typename Model::Control& u,
+                                            const Vec<Model::state_dim>& xm, const Vec<Model::noise_dim>& zw,
+                                            const Vec<Model::obs_dim>& zv, Vec<Model::state_dim>& next,
+                                            Vec<Model::obs_dim>& increment) const {
     constexpr int p = Model::obs_dim;
     const double sqrt_dt = math::sqrt(dt);
     const auto dw = zw * sqrt_dt;
     Vec<p> dv;
     if constexpr (has_deterministic_observation_noise<Model>)
-      dv = model.observation_noise_increment(t, dt);
+      dv = model.observation_noise_increment(at, dt);
     else
       dv = zv * sqrt_dt;
-    increment = model.observation(t, xm) * dt + model.observation_noise(t) * dv;
-    next = xm + model.drift(t, xm, u) * dt + model.diffusion(t, xm) * dw;
+    increment = model.observation(at, xm) * dt + model.observation_noise(at) * dv;
+    next = xm + model.drift(at, xm, u) * dt + model.diffusion(at, xm) * dw;
   }
 
   /// Normals per member of a host chunk: process noise, then observation noise.
@@ -151,7 +158,7 @@ struct EulerMaruyamaTruthStep {
     for (int i = 0; i < n; ++i) xm[i] = xs[member + i * x_stride];
     for (int k = 0; k < q; ++k) zw[k] = z[k * host_member_chunk];
     for (int k = 0; k < p; ++k) zv[k] = z[(q + k) * host_member_chunk];
-    advance_state(Model::Control::zero(), xm, zw, zv, next, increment);
+    advance_state(t, Model::Control::zero(), xm, zw, zv, next, increment);
     for (int i = 0; i < p; ++i) dys[member + i * dy_stride] = ok ? increment[i] : dys[member + i * dy_stride];
     for (int i = 0; i < n; ++i) xs[member + i * x_stride] = ok ? next[i] : xm[i];
     return all_finite(next) && all_finite(increment);
@@ -225,12 +232,21 @@ struct DiscreteTruthStep {
   KOKKOS_INLINE_FUNCTION void operator()(const int member) const { step_member(member, Model::Control::zero()); }
 
   KOKKOS_INLINE_FUNCTION void step_member(const int member, const typename Model::Control& u) const {
-    constexpr int n = Model::state_dim, p = Model::obs_dim, q = Model::noise_dim;
-    const auto w = discrete_noise_draws<q>(RngKey{seed, Stream::process_noise}, member, step);
-    const auto v = discrete_noise_draws<p>(RngKey{seed, Stream::observation_noise}, member, step);
-    const Vec<n> next = model.transition(t, load<n>(x, member), u) + model.process_noise(w.normals, w.uniform);
+    step_stored_state<Model>(*this, member, u);
+  }
+
+  /// step_member as step k at time `at` (= k) from x[k] = xm, read by the caller; stores and returns x[k+1] and
+  /// z[k+1].
+  KOKKOS_INLINE_FUNCTION void step_from(const int member, const double at, const std::uint32_t k,
+                                        const typename Model::Control& u, const Vec<Model::state_dim>& xm,
+                                        Vec<Model::state_dim>& next, Vec<Model::obs_dim>& increment) const {
+    constexpr int p = Model::obs_dim, q = Model::noise_dim;
+    const auto w = discrete_noise_draws<q>(RngKey{seed, Stream::process_noise}, member, k);
+    const auto v = discrete_noise_draws<p>(RngKey{seed, Stream::observation_noise}, member, k);
+    next = model.transition(at, xm, u) + model.process_noise(w.normals, w.uniform);
+    increment = model.observation(at + 1.0, next) + model.observation_noise_sample(v.normals, v.uniform);
     store(x, member, next);
-    store(dy, member, model.observation(t + 1.0, next) + model.observation_noise_sample(v.normals, v.uniform));
+    store(dy, member, increment);
   }
 };
 

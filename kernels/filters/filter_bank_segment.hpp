@@ -127,18 +127,30 @@ struct FilterBankTeamSegment {
   KOKKOS_INLINE_FUNCTION void operator()(const Team& team) const {
     const int b = blocks(first_team + team.league_rank());
     const int begin = b * moment_block_size, end = block_end(b, members);
-    // The step kernel, one copy per team in its scratch, its time, index and output flag set by the team's first
-    // thread before each step: a copy per thread sat on each thread's stack (3240 bytes of local memory per thread for
-    // sine's bank, by ptxas), and so these segments ran at 34-44% of the rate of a step at a time on an H200.
-    // (get_shmem hands out the team's scratch piece by piece: once per launch.)
+#if KUSHNER_CUDA_DEVICE_PASS
+    // Each thread passes a step's time, index and output flag to the step kernel, read where the launch put it
+    // (constant memory): a copy per thread sat on each thread's stack (3240 bytes of local memory per thread for sine's
+    // bank, by ptxas), and a copy per team in shared memory, its fields set by the team's first thread between two
+    // barriers, made every view's pointer and stride a shared-memory load and every step two barriers. The team
+    // meets only at output steps, where its warps reduce what its threads wrote.
+    for (int s = s0; s < s1; ++s) {
+      const long k = first_step + s;
+      const bool output = output_of[s] >= 0;
+      for (int m = begin + team.team_rank(); m < end; m += team.team_size())
+        first.step_at(m, k * dt, static_cast<std::uint32_t>(k), output);  // k * dt: run_step_kernel's time
+      if (!output) continue;
+      team.team_barrier();  // every member's snapshot values are written
+      reduce_block(team, rows.data() + (static_cast<std::size_t>(output_of[s]) * num_blocks + b) * width, begin, end,
+                   nullptr);
+      team.team_barrier();  // and read, before a later output step writes them again
+    }
+#else
+    // The host's team (one thread, the tests' check of this form) steps its block in the step kernel's own chunks,
+    // which read the step's fields: one copy per team in its scratch, set before each step.
     const std::ptrdiff_t step_bytes = sizeof(Step);  // copies: get_shmem takes a reference
     Step* const step = static_cast<Step*>(team.team_shmem().get_shmem_aligned(step_bytes, step_alignment));
-#if KUSHNER_CUDA_DEVICE_PASS
-    double* const scratch = nullptr;  // the warps meet by shuffles
-#else
     const std::ptrdiff_t bytes = block_team_scratch_bytes;
     double* const scratch = static_cast<double*>(team.team_shmem().get_shmem(bytes));
-#endif
     Kokkos::single(Kokkos::PerTeam(team), [&]() { new (step) Step(first); });
     for (int s = s0; s < s1; ++s) {
       Kokkos::single(Kokkos::PerTeam(team), [&]() {
@@ -156,14 +168,16 @@ struct FilterBankTeamSegment {
     }
     team.team_barrier();
     Kokkos::single(Kokkos::PerTeam(team), [&]() { step->~Step(); });
+#endif
   }
 
-  /// Team scratch of a launch: the team's step kernel (with room to align it), and on the host team_block_statistic's
-  /// (sizeof(Step) is a multiple of its alignment, at least a double's: the doubles that follow it are aligned).
+  /// Team scratch of a host launch: the team's step kernel (with room to align it) and team_block_statistic's
+  /// (sizeof(Step) is a multiple of its alignment, at least a double's: the doubles that follow it are aligned). A
+  /// GPU's team takes none.
   static constexpr std::ptrdiff_t step_alignment = alignof(Step) > 16 ? alignof(Step) : 16;
-  static constexpr std::size_t scratch_bytes =
-      step_alignment + sizeof(Step) +
-      (Kokkos::SpaceAccessibility<Kokkos::HostSpace, MemSpace>::accessible ? block_team_scratch_bytes : 0);
+  static constexpr std::size_t scratch_bytes = Kokkos::SpaceAccessibility<Kokkos::HostSpace, MemSpace>::accessible
+                                                   ? step_alignment + sizeof(Step) + block_team_scratch_bytes
+                                                   : 0;
 
  private:
   template <class Team>

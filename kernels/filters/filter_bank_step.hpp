@@ -50,23 +50,32 @@ struct FilterBankStep {
     return !(Model::discrete_time || TruthModel::discrete_time) && filter_step_is_pure<Filter, Model::state_dim>;
   }
 
-  KOKKOS_INLINE_FUNCTION void operator()(const int member) const {
+  KOKKOS_INLINE_FUNCTION void operator()(const int member) const { step_at(member, truth.t, truth.step, record); }
+
+  /// operator() as step k at time `at`, an output step where `at_output` (a step at a time: the fields truth.t,
+  /// truth.step and record). A GPU's segment passes each of its steps' here and reads the kernel where it is, in
+  /// constant memory: a copy whose fields it set per step sat in shared memory, and every view's pointer and stride
+  /// was then a load of its own.
+  KOKKOS_INLINE_FUNCTION void step_at(const int member, const double at, const std::uint32_t k,
+                                      const bool at_output) const {
     constexpr int n = Model::state_dim, p = Model::obs_dim;
-    if (truth_status(member) != Status::ok) {
-      if (record) (mark_unscored(static_cast<const FilterSlot<Filters, MemSpace>&>(slots), member), ...);
+    const Status truth_was = truth_status(member);
+    const Vec<n> x0 = load<n>(truth.x, member);  // read with the status: one wait for memory, not two
+    if (truth_was != Status::ok) {
+      if (at_output) (mark_unscored(static_cast<const FilterSlot<Filters, MemSpace>&>(slots), member), ...);
       return;
     }
-    truth(member);
-    const Vec<n> x = load<n>(truth.x, member);
-    const Vec<p> dy = load<p>(truth.dy, member);
+    Vec<n> x;
+    Vec<p> dy;
+    truth.step_from(member, at, k, TruthModel::Control::zero(), x0, x, dy);
     if (!(all_finite(x) && all_finite(dy))) {
       truth_status(member) = Status::non_finite;
-      if (record) (mark_unscored(static_cast<const FilterSlot<Filters, MemSpace>&>(slots), member), ...);
+      if (at_output) (mark_unscored(static_cast<const FilterSlot<Filters, MemSpace>&>(slots), member), ...);
       return;
     }
-    const Mat<p, p> R = model.observation_noise(truth.t);
-    const StepInput<p> in{truth.t, truth.dt, dy, R * transpose(R)};
-    (advance(static_cast<const FilterSlot<Filters, MemSpace>&>(slots), model, member, in, x, record), ...);
+    const Mat<p, p> R = model.observation_noise(at);
+    const StepInput<p> in{at, truth.dt, dy, R * transpose(R)};
+    (advance(static_cast<const FilterSlot<Filters, MemSpace>&>(slots), model, member, in, x, at_output), ...);
   }
 
   /// Host: operator() for the members [begin, end) of one chunk (kernels/for_each_member.hpp), with the members

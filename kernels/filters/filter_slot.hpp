@@ -44,18 +44,32 @@ struct FilterSlot {
   BankVector<MemSpace> snapshot;        // (member, SnapshotColumn)
 };
 
-/// Scores a member's estimate m (covariance factor L, from semidefinite_cholesky) against the truth x.
+/// A member's three score sums (ScoreColumn), read together: each read-add-write of one after the other was a round
+/// trip to memory of its own (the compiler cannot move a read above a write it cannot prove apart), three per filter
+/// and step, on a GPU each a wait of some hundred cycles.
+struct ScoreSums {
+  double squared_error, nees, nees_points;
+};
+
+template <class Slot>
+KOKKOS_INLINE_FUNCTION ScoreSums load_score_sums(const Slot& s, int member) {
+  return {s.score(member, squared_error_sum), s.score(member, nees_sum), s.score(member, nees_points)};
+}
+
+/// Scores a member's estimate m (covariance factor L, from semidefinite_cholesky) against the truth x; `sums`: the
+/// member's score sums before this point (load_score_sums).
 template <int N, class Slot>
 KOKKOS_INLINE_FUNCTION void score_member(const Slot& s, int member, const Vec<N>& x, const Vec<N>& m,
-                                         const Mat<N, N>& L, Definiteness definiteness, bool record) {
+                                         const Mat<N, N>& L, Definiteness definiteness, bool record,
+                                         const ScoreSums& sums) {
   const Vec<N> e = m - x;
   const double squared_error = dot(e, e);
   const bool has_nees = definiteness == Definiteness::positive_definite;
   const double nees = has_nees ? cholesky_quadratic_form(L, e) : math::quiet_nan();
-  s.score(member, squared_error_sum) += squared_error;
+  s.score(member, squared_error_sum) = sums.squared_error + squared_error;
   if (has_nees) {
-    s.score(member, nees_sum) += nees;
-    s.score(member, nees_points) += 1.0;
+    s.score(member, nees_sum) = sums.nees + nees;
+    s.score(member, nees_points) = sums.nees_points + 1.0;
   }
   if (record) {
     s.snapshot(member, snapshot_squared_error) = squared_error;
@@ -63,53 +77,16 @@ KOKKOS_INLINE_FUNCTION void score_member(const Slot& s, int member, const Vec<N>
   }
 }
 
+template <int N, class Slot>
+KOKKOS_INLINE_FUNCTION void score_member(const Slot& s, int member, const Vec<N>& x, const Vec<N>& m,
+                                         const Mat<N, N>& L, Definiteness definiteness, bool record) {
+  score_member(s, member, x, m, L, definiteness, record, load_score_sums(s, member));
+}
+
 template <class Slot>
 KOKKOS_INLINE_FUNCTION void mark_unscored(const Slot& s, int member) {
   if (!s.enabled) return;
   for (int c = 0; c < num_snapshot_columns; ++c) s.snapshot(member, c) = math::quiet_nan();
-}
-
-/// One step of one member for one filter: the filter's step, then the divergence checks (non-finite values;
-/// P not positive semidefinite), then the scores against the new truth x. A diverged member keeps its last
-/// good m, P and is not updated again. In a closed loop, `control_shift` = B(t) u dt, the known input's part of
-/// the mean's Euler step: every filter's prediction is m + (a + B u) dt with P unchanged by a known additive
-/// input (kernels/filters/filter_step.hpp), so adding it after the filter's own step is that step exactly. A
-/// discrete-time filter predicts before it updates with z[k+1], so it takes B u[k] into its step's prediction.
-template <class Model, class Filter, class MemSpace>
-KOKKOS_INLINE_FUNCTION void advance(const FilterSlot<Filter, MemSpace>& s, const Model& model, int member,
-                                    const StepInput<Model::obs_dim>& in, const Vec<Model::state_dim>& x, bool record,
-                                    const Vec<Model::state_dim>& control_shift = Vec<Model::state_dim>::zero()) {
-  constexpr int n = Model::state_dim;
-  if (!s.enabled) return;
-  if (s.status(member) != Status::ok) {
-    if (record) mark_unscored(s, member);
-    return;
-  }
-  Vec<n> m = load<n>(s.m, member);
-  Mat<n, n> P = load_symmetric<n>(s.P, member);
-  Status status;
-  if constexpr (Model::discrete_time) {
-    status = s.filter.step(model, member, in, m, P, control_shift);
-  } else {
-    status = s.filter.step(model, member, in, m, P);
-    m += control_shift;
-    if constexpr (detail::has_known_input<Filter, n>::value) s.filter.apply_known_input(member, control_shift);
-  }
-  if (status == Status::ok && !(all_finite(m) && all_finite(P))) status = Status::non_finite;
-  Mat<n, n> L;
-  Definiteness definiteness = Definiteness::indefinite;
-  if (status == Status::ok) {
-    definiteness = semidefinite_cholesky(P, L, covariance_tolerance);
-    if (definiteness == Definiteness::indefinite) status = Status::not_positive_definite;
-  }
-  if (status != Status::ok) {
-    s.status(member) = status;
-    if (record) mark_unscored(s, member);
-    return;
-  }
-  store(s.m, member, m);
-  store_symmetric(s.P, member, P);
-  score_member(s, member, x, m, L, definiteness, record);
 }
 
 namespace detail {
@@ -129,6 +106,62 @@ struct has_fixed_method<Filter, std::void_t<decltype(std::declval<const Filter&>
 template <class Filter, int N>
 constexpr bool filter_step_is_pure = !detail::is_randomized<Filter>::value && !detail::has_prepass<Filter>::value &&
                                      !detail::has_known_input<Filter, N>::value;
+
+/// One step of one member for one filter: the filter's step, then the divergence checks (non-finite values;
+/// P not positive semidefinite), then the scores against the new truth x. A diverged member keeps its last
+/// good m, P and is not updated again. In a closed loop, `control_shift` = B(t) u dt, the known input's part of
+/// the mean's Euler step: every filter's prediction is m + (a + B u) dt with P unchanged by a known additive
+/// input (kernels/filters/filter_step.hpp), so adding it after the filter's own step is that step exactly. A
+/// discrete-time filter predicts before it updates with z[k+1], so it takes B u[k] into its step's prediction.
+template <class Model, class Filter, class MemSpace>
+KOKKOS_INLINE_FUNCTION void advance(const FilterSlot<Filter, MemSpace>& s, const Model& model, int member,
+                                    const StepInput<Model::obs_dim>& in, const Vec<Model::state_dim>& x, bool record,
+                                    const Vec<Model::state_dim>& control_shift = Vec<Model::state_dim>::zero()) {
+  constexpr int n = Model::state_dim;
+  if (!s.enabled) return;
+  // A pure continuous-time filter steps before its member's status is looked at, a frozen member's step then thrown
+  // away: so the status, m, P and the score sums are read together, one wait for memory where reading m and P behind
+  // the status' branch and the sums behind the stores made three (a GPU's segment stalled most on those).
+  constexpr bool speculative = !Model::discrete_time && filter_step_is_pure<Filter, n>;
+  const Status old_status = s.status(member);
+  if (!speculative && old_status != Status::ok) {
+    if (record) mark_unscored(s, member);
+    return;
+  }
+  Vec<n> m = load<n>(s.m, member);
+  Mat<n, n> P = load_symmetric<n>(s.P, member);
+  const ScoreSums sums = speculative ? load_score_sums(s, member) : ScoreSums{};
+  Status status;
+  if constexpr (Model::discrete_time) {
+    status = s.filter.step(model, member, in, m, P, control_shift);
+  } else {
+    status = s.filter.step(model, member, in, m, P);
+    m += control_shift;
+    if constexpr (detail::has_known_input<Filter, n>::value) s.filter.apply_known_input(member, control_shift);
+  }
+  if (status == Status::ok && !(all_finite(m) && all_finite(P))) status = Status::non_finite;
+  Mat<n, n> L;
+  Definiteness definiteness = Definiteness::indefinite;
+  if (status == Status::ok) {
+    definiteness = semidefinite_cholesky(P, L, covariance_tolerance);
+    if (definiteness == Definiteness::indefinite) status = Status::not_positive_definite;
+  }
+  if (speculative && old_status != Status::ok) {  // frozen: the step above is not taken
+    if (record) mark_unscored(s, member);
+    return;
+  }
+  if (status != Status::ok) {
+    s.status(member) = status;
+    if (record) mark_unscored(s, member);
+    return;
+  }
+  store(s.m, member, m);
+  store_symmetric(s.P, member, P);
+  if constexpr (speculative)
+    score_member(s, member, x, m, L, definiteness, record, sums);
+  else
+    score_member(s, member, x, m, L, definiteness, record);
+}
 
 /// advance() of one member as one lane of a host loop over members in SIMD lanes (FilterBankStep::run_chunk): the
 /// step, the checks and the scores are computed whatever the member's state, and what advance() would store is
