@@ -140,8 +140,7 @@ struct FilterBankTeamSegment {
         first.step_at(m, k * dt, static_cast<std::uint32_t>(k), output);  // k * dt: run_step_kernel's time
       if (!output) continue;
       team.team_barrier();  // every member's snapshot values are written
-      reduce_block(team, rows.data() + (static_cast<std::size_t>(output_of[s]) * num_blocks + b) * width, begin, end,
-                   nullptr);
+      reduce_block(team, output_row(s, b), begin, end, nullptr);
       team.team_barrier();  // and read, before a later output step writes them again
     }
 #else
@@ -160,11 +159,9 @@ struct FilterBankTeamSegment {
         step->record = output_of[s] >= 0;
       });
       team.team_barrier();  // the step's fields are set
-      step_block(team, *step, begin, end);
+      step_block(*step, begin, end);
       team.team_barrier();  // every member took the step (its snapshot values are written) before the fields change
-      if (output_of[s] >= 0)
-        reduce_block(team, rows.data() + (static_cast<std::size_t>(output_of[s]) * num_blocks + b) * width, begin, end,
-                     scratch);
+      if (output_of[s] >= 0) reduce_block(team, output_row(s, b), begin, end, scratch);
     }
     team.team_barrier();
     Kokkos::single(Kokkos::PerTeam(team), [&]() { step->~Step(); });
@@ -180,18 +177,19 @@ struct FilterBankTeamSegment {
                                                    : 0;
 
  private:
-  template <class Team>
-  KOKKOS_INLINE_FUNCTION void step_block(const Team& team, const Step& step, const int begin, const int end) const {
+  /// The host's team (one thread: FilterBank launches host teams of one) steps its block in the step kernel's own
+  /// chunks (its bits: lanes and vector math).
+  KOKKOS_INLINE_FUNCTION void step_block(const Step& step, const int begin, const int end) const {
 #if !KUSHNER_CUDA_DEVICE_PASS
-    if constexpr (Kokkos::SpaceAccessibility<Kokkos::HostSpace, MemSpace>::accessible) {
-      if (team.team_size() == 1) {  // a host team: the step kernel's own chunks (its bits: lanes and vector math)
-        for (int chunk = begin; chunk < end; chunk += host_member_chunk)
-          run_member_chunk(step, chunk, end - chunk < host_member_chunk ? end : chunk + host_member_chunk);
-        return;
-      }
-    }
+    if constexpr (Kokkos::SpaceAccessibility<Kokkos::HostSpace, MemSpace>::accessible)
+      for (int chunk = begin; chunk < end; chunk += host_member_chunk)
+        run_member_chunk(step, chunk, end - chunk < host_member_chunk ? end : chunk + host_member_chunk);
 #endif
-    for (int m = begin + team.team_rank(); m < end; m += team.team_size()) step(m);
+  }
+
+  /// Block b's row of output step s's output in `rows`.
+  KOKKOS_INLINE_FUNCTION double* output_row(const int s, const int b) const {
+    return rows.data() + (static_cast<std::size_t>(output_of[s]) * num_blocks + b) * width;
   }
 
   template <class Team>
