@@ -226,11 +226,11 @@ struct NoExtraEstimators {
 };
 
 /// run_compare_command with the truths following `truth_model` (same dimensions as `model`, e.g. the system a
-/// Taylor model approximates, or `model` with a deterministic observation noise) and the estimators that
-/// make_extras(space) returns run beside the bank (run_filters). summary.json then also records the truths'
-/// model under "truth". With options.checkpoints the run saves checkpoints into `out` (on SIGINT/SIGTERM, and
-/// every options.checkpoint_every seconds when given), continues from `resume` when given, and removes its
-/// checkpoint once its results are written.
+/// Taylor model approximates, or `model` with other parameters such as sine_observation_noise) and the estimators
+/// that make_extras(space) returns run beside the bank (run_filters). summary.json then also records the truths'
+/// model under "truth" where it is not `model`. With options.checkpoints the run saves checkpoints into `out` (on
+/// SIGINT/SIGTERM, and every options.checkpoint_every seconds when given), continues from `resume` when given, and
+/// removes its checkpoint once its results are written.
 template <class Model, class TruthModel, class MakeExtras = NoExtraEstimators>
 nlohmann::json run_compare_with_truth(const TruthModel& truth_model, const Model& model, const CompareOptions& options,
                                       const OptionValues& settings, const TimeGrid& grid, const RunContext& context,
@@ -269,12 +269,15 @@ nlohmann::json run_compare_with_truth(const TruthModel& truth_model, const Model
         settings, particle, [&](long done) { progress.update(done); }, observer, make_extras(space), checkpointing);
     summary = run_metadata(context);
     summary["model"] = model_summary(model);
-    if constexpr (!std::is_same_v<TruthModel, Model>)
+    bool same_truth = false;
+    if constexpr (std::is_same_v<TruthModel, Model>)
+      same_truth = parameter_values(truth_model) == parameter_values(model);
+    if (!same_truth)
       summary["truth"] = {
           {"name", TruthModel::name},
           {"parameters", parameter_values(truth_model)},
           {"observation_noise",
-           has_deterministic_observation_noise<TruthModel> ? "deterministic: sin t on every component" : "Brownian"}};
+           sine_observation_noise(truth_model) ? "deterministic: sin t on every component" : "Brownian"}};
     summary["members"] = options.run.members;
     summary["T"] = options.run.T;
     summary["dt"] = options.run.dt;

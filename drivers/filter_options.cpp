@@ -57,10 +57,12 @@ void add_filter_options(CLI::App& app, FilterOptions& o) {
   app.add_option("--ess-threshold", o.ess_threshold,
                  "PF resamples a member when its effective sample size falls below this fraction of --particles")
       ->capture_default_str();
-  app.add_option("--precision", o.precision,
-                 "PF arithmetic: fp64; mixed (normals drawn in fp32, particles, weights and sums in fp64; faster on "
-                 "GPUs); or fp32 (mixed's normals, particles and log-weights stored in fp32: about half the "
-                 "memory per particle; each step computed in fp64, sums in fp64)")
+  app.add_option(
+         "--precision", o.precision,
+         "PF arithmetic: fp64; mixed (normals drawn in fp32, particles, weights and sums in fp64; faster on "
+         "GPUs); or fp32 (mixed's normals, particles and log-weights stored in fp32: about half the "
+         "memory per particle; each step computed in fp32 where the model's dynamics take it (sine, linear, ou), "
+         "else in fp64; sums in fp64)")
       ->capture_default_str();
   app.add_option("--step-pairs", o.step_pairs,
                  "PF takes two steps per pass over its particles, the bank scoring one step behind: auto (where its "

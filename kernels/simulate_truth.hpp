@@ -8,6 +8,7 @@
 #include "kernels/for_each_member.hpp"
 #include "kernels/particle_filter/particle_draws.hpp"
 #include "kernels/rng.hpp"
+#include "models/sine_observation_noise.hpp"
 
 #include <Kokkos_Core.hpp>
 
@@ -19,17 +20,22 @@ namespace kushner {
 
 namespace detail {
 template <class Model, class = void>
-struct has_observation_noise_increment : std::false_type {};
+struct has_sine_observation_noise_option : std::false_type {};
 template <class Model>
-struct has_observation_noise_increment<
-    Model, std::void_t<decltype(std::declval<const Model&>().observation_noise_increment(0.0, 0.0))>> : std::true_type {
-};
+struct has_sine_observation_noise_option<
+    Model, std::void_t<decltype(std::declval<const Model&>().observation_noise_is_sine())>> : std::true_type {};
 }  // namespace detail
 
-/// Whether Model's observation noise is a given deterministic path (models/sine_observation_noise.hpp): the
-/// truths then take dv = model.observation_noise_increment(t, dt) instead of a Brownian increment.
+/// Whether the truths' observation noise is Basin's sin t path (models/sine_observation_noise.hpp: a run-time
+/// parameter of the models that have the option): they then take dv = cos t - cos(t + dt) instead of a Brownian
+/// increment.
 template <class Model>
-constexpr bool has_deterministic_observation_noise = detail::has_observation_noise_increment<Model>::value;
+KOKKOS_INLINE_FUNCTION bool sine_observation_noise(const Model& model) {
+  if constexpr (detail::has_sine_observation_noise_option<Model>::value)
+    return model.observation_noise_is_sine();
+  else
+    return false;
+}
 
 /// x(member) = mean + root z, z standard normal from Stream::truth_initial (root: any square root of the
 /// initial covariance, computed on the host, so that a singular covariance (fixed start) is allowed).
@@ -64,8 +70,8 @@ KOKKOS_INLINE_FUNCTION void step_stored_state(const Truth& truth, const int memb
 /// One Euler-Maruyama step of every member over [t, t + dt]:
 ///   dy = h(t, x) dt + R dv,   x <- x + f(t, x, u) dt + G(t, x) dw,   dw, dv ~ N(0, dt I),
 /// with u = 0 (open loop) or, in a closed loop, the member's control (step_member). The draws depend on seed,
-/// member and step only, so every controller's loop sees the same noise (common random numbers).
-/// or dv = model.observation_noise_increment(t, dt) where the model's observation noise is a deterministic path.
+/// member and step only, so every controller's loop sees the same noise (common random numbers); or
+/// dv = cos t - cos(t + dt) where the model's observation noise is the sine path (sine_observation_noise).
 template <class Model, class MemSpace>
 struct EulerMaruyamaTruthStep {
   Model model;
@@ -89,7 +95,7 @@ struct EulerMaruyamaTruthStep {
                                         Vec<Model::state_dim>& next, Vec<Model::obs_dim>& increment) const {
     constexpr int p = Model::obs_dim, q = Model::noise_dim;
     Vec<p> zv = Vec<p>::zero();
-    if constexpr (!has_deterministic_observation_noise<Model>)
+    if (!sine_observation_noise(model))
       zv = normals<p, Random123Draws>(RngKey{seed, Stream::observation_noise}, member, k);
     advance_state(at, u, xm, normals<q, Random123Draws>(RngKey{seed, Stream::process_noise}, member, k), zv, next,
                   increment);
@@ -98,7 +104,7 @@ struct EulerMaruyamaTruthStep {
   }
 
   /// The step from x(at) = xm with the standard normals zw (process noise) and zv (observation noise; unused where
-  /// the model's observation noise is a given path).
+  /// the model's observation noise is the sine path).
   KOKKOS_INLINE_FUNCTION void advance_state(const double at, const typename Model::Control& u,
                                             const Vec<Model::state_dim>& xm, const Vec<Model::noise_dim>& zw,
                                             const Vec<Model::obs_dim>& zv, Vec<Model::state_dim>& next,
@@ -107,8 +113,8 @@ struct EulerMaruyamaTruthStep {
     const double sqrt_dt = math::sqrt(dt);
     const auto dw = zw * sqrt_dt;
     Vec<p> dv;
-    if constexpr (has_deterministic_observation_noise<Model>)
-      dv = model.observation_noise_increment(at, dt);
+    if (sine_observation_noise(model))
+      dv = Vec<p>::constant(SineObservationNoiseOption::sine_noise_increment(at, dt));
     else
       dv = zv * sqrt_dt;
     increment = model.observation(at, xm) * dt + model.observation_noise(at) * dv;
@@ -126,7 +132,7 @@ struct EulerMaruyamaTruthStep {
   KUSHNER_FLATTEN void draw_lanes(const int begin, const int end, double* const z) const {
     constexpr int p = Model::obs_dim, q = Model::noise_dim;
     draw_lane_normals<q>(begin, end, RngKey{seed, Stream::process_noise}, z);
-    if constexpr (!has_deterministic_observation_noise<Model>)
+    if (!sine_observation_noise(model))
       draw_lane_normals<p>(begin, end, RngKey{seed, Stream::observation_noise}, z + q * host_member_chunk);
   }
 

@@ -7,18 +7,20 @@
 // Paper values (002 L1505): v = l = 1, u = 0.05, truth from phi(0) = delta(0) = 0, filters from
 // m(0) = (10, 0.1), P(0) = [[100, 10], [10, 1]] (singular: every filter here works without P^{-1}), V = I
 // (r = 1), no process noise (q = 0). The paper "realizes" the observation noises as sin t; here they are
-// Brownian. The constant u is the open-loop steering rate; `kushner control` adds a control w to it,
-// ddelta = (u + w) dt (B = (0, 1), as in Basin's regulator and controller, 002 (14), (16)).
+// Brownian unless sine_observation_noise = 1. The constant u is the open-loop steering rate; `kushner control` adds a
+// control w to it, ddelta = (u + w) dt (B = (0, 1), as in Basin's regulator and controller, 002 (14), (16)).
 #include "core/errors.hpp"
 #include "core/math.hpp"
 #include "core/small_matrix.hpp"
 #include "models/drift_forms.hpp"
 #include "models/initial_law.hpp"
+#include "models/sine_observation_noise.hpp"
 
 namespace kushner {
 
-/// What the two car models share: parameters, initial laws, noise and the observation of both angles.
-struct CarBase : InitialLaw<2> {
+/// What the two car models share: parameters, initial laws, noise and the observation of both angles; the truths'
+/// observation noise Brownian or, with sine_observation_noise = 1, the paper's sin t (`kushner reproduce basin-car-*`).
+struct CarBase : InitialLaw<2>, SineObservationNoiseOption {
   static constexpr int state_dim = 2, obs_dim = 2, noise_dim = 2, control_dim = 1;
   static constexpr bool discrete_time = false;
   static constexpr bool linear_observation = true;
@@ -42,10 +44,14 @@ struct CarBase : InitialLaw<2> {
     visit("u", u, "steering rate, constant and known (seed 002: 0.05)");
     visit("q", q, "process noise intensity on both angles (paper: 0)");
     visit("r", r, "observation noise intensity of both angles (seed 002: V = I)");
+    sine_observation_noise_parameter(visit);
     initial_law_parameters(visit);
   }
 
-  void validate() const { KUSHNER_INPUT_REQUIRE(l != 0.0, "l: the wheelbase must not be 0"); }
+  void validate() const {
+    KUSHNER_INPUT_REQUIRE(l != 0.0, "l: the wheelbase must not be 0");
+    validate_sine_observation_noise();
+  }
 
   KOKKOS_INLINE_FUNCTION Mat<2, 1> control_input(double) const { return {{{0.0}, {1.0}}}; }
   KOKKOS_INLINE_FUNCTION Mat<2, 2> diffusion(double, const Vec<2>&) const { return Mat<2, 2>::diagonal(q); }

@@ -5,15 +5,17 @@
 // f as in (18) (drift() below, equation by equation). All parameters 1 as in the paper (002 L1770; K_32 and
 // K_L3 are listed there but do not occur in (18)); truth from x(0) = 0, filters from m(0) = 0.5, P(0) = I.
 // The paper has no state noise (q = 0) and "realizes" the observation noises as sin t; here they are Brownian
-// with V = I (r = 1, the gain printed as P). It states no horizon.
+// with V = I (r = 1, the gain printed as P) unless sine_observation_noise = 1 (`kushner reproduce basin-terpolymer`).
+// It states no horizon.
 #include "core/errors.hpp"
 #include "core/small_matrix.hpp"
 #include "models/drift_forms.hpp"
 #include "models/initial_law.hpp"
+#include "models/sine_observation_noise.hpp"
 
 namespace kushner {
 
-struct TerpolymerModel : InitialLaw<10> {
+struct TerpolymerModel : InitialLaw<10>, SineObservationNoiseOption {
   static constexpr int state_dim = 10, obs_dim = 10, noise_dim = 10, control_dim = 0;
   static constexpr bool discrete_time = false;
   static constexpr bool linear_observation = true;
@@ -58,11 +60,13 @@ struct TerpolymerModel : InitialLaw<10> {
     v("K_t3", K_t3, "termination rate of mu_R");
     v("q", q, "process noise intensity on every state (paper: 0)");
     v("r", r, "observation noise intensity on every state");
+    sine_observation_noise_parameter(v);
     initial_law_parameters(v);
   }
 
   void validate() const {
     KUSHNER_INPUT_REQUIRE(V != 0.0 && theta != 0.0, "V, theta: must not be 0 (got " << V << ", " << theta << ")");
+    validate_sine_observation_noise();
   }
 
   /// Seed 002 ACC03 (18).

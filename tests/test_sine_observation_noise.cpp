@@ -1,12 +1,13 @@
-// Basin's deterministic observation "noise" (models/sine_observation_noise.hpp) and truths that follow another
-// model than the filters (FilterBank's TruthModel): one step by hand, every member the same (to the last bits of
-// the host's vector cos), every backend the same bits, the Brownian path untouched, and a bank whose truths follow the
-// tan car while its filters use the Taylor model.
+// Basin's deterministic observation "noise" (models/sine_observation_noise.hpp: the cars' and the reactor's parameter
+// sine_observation_noise) and truths that follow another model than the filters (FilterBank's TruthModel): one step
+// by hand, every member the same (to the last bits of the host's vector cos), every backend the same bits, the
+// Brownian path untouched with the parameter 0 and in models without it, and a bank whose truths follow the tan car
+// while its filters use the Taylor model.
 #include "engine/filter_bank.hpp"
 #include "engine/truth_bank.hpp"
 #include "models/car_model.hpp"
+#include "models/parameters.hpp"
 #include "models/sine_model.hpp"
-#include "models/sine_observation_noise.hpp"
 #include "tests/test_spaces.hpp"
 
 #include <gtest/gtest.h>
@@ -25,9 +26,9 @@ TYPED_TEST(SineObservationNoiseTest, IncrementIsTheIntegralOfSinOverTheStepForEv
   using Space = TypeParam;
   CarTaylor3Model car;
   car.x0_mean = Vec<2>{{0.3, 0.2}};
-  const SineObservationNoise<CarTaylor3Model> truth(car);
+  car.sine_observation_noise = 1.0;
   constexpr long members = 5;
-  TruthBank<Space, SineObservationNoise<CarTaylor3Model>> bank(Space(), truth, members, 7);
+  TruthBank<Space, CarTaylor3Model> bank(Space(), car, members, 7);
   const double dt = 0.01;
   bank.step(0, dt);  // [0, dt]
   bank.step(1, dt);  // [dt, 2 dt]
@@ -49,14 +50,16 @@ TYPED_TEST(SineObservationNoiseTest, IncrementIsTheIntegralOfSinOverTheStepForEv
   }
 }
 
-TEST(SineObservationNoise, BrownianModelsKeepTheirRandomIncrements) {
+TEST(SineObservationNoise, BrownianUnlessTheParameterIsOne) {
   using Space = Kokkos::DefaultExecutionSpace;
-  static_assert(!has_deterministic_observation_noise<SineModel>);
-  static_assert(has_deterministic_observation_noise<SineObservationNoise<SineModel>>);
-  SineModel model;
-  model.x0_cov = Mat<1, 1>::zero();
-  TruthBank<Space, SineModel> brownian(Space(), model, 2, 3);
-  TruthBank<Space, SineObservationNoise<SineModel>> sine(Space(), SineObservationNoise<SineModel>(model), 2, 3);
+  EXPECT_FALSE(sine_observation_noise(SineModel()));  // a model without the option
+  CarTaylor3Model car;
+  car.x0_cov = Mat<2, 2>::zero();
+  EXPECT_FALSE(sine_observation_noise(car));  // the default
+  TruthBank<Space, CarTaylor3Model> brownian(Space(), car, 2, 3);
+  apply_parameters(car, {{"sine_observation_noise", "1"}});  // as `--set sine_observation_noise=1` does
+  EXPECT_TRUE(sine_observation_noise(car));
+  TruthBank<Space, CarTaylor3Model> sine(Space(), car, 2, 3);
   brownian.step(0, 0.01);
   sine.step(0, 0.01);
   Space().fence();
@@ -64,7 +67,9 @@ TEST(SineObservationNoise, BrownianModelsKeepTheirRandomIncrements) {
   const auto b = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), sine.observations());
   EXPECT_NE(a(0, 0), a(1, 0)) << "Brownian members share their noise";
   EXPECT_EQ(b(0, 0), b(1, 0));
-  EXPECT_DOUBLE_EQ(b(0, 0), 1.0 * 0.01 + model.r * (1.0 - std::cos(0.01)));
+  EXPECT_DOUBLE_EQ(b(0, 0), car.r * (1.0 - std::cos(0.01)));  // phi(0) = 0
+  car.sine_observation_noise = 0.5;
+  EXPECT_THROW(car.validate(), InputError);
 }
 
 /// The car of seed 002 L1505 (tan truth, Taylor-model filters): the truths follow tan, not the Taylor model.

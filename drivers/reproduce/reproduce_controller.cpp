@@ -11,7 +11,6 @@
 #include "kernels/control/control_law.hpp"
 #include "models/car_model.hpp"
 #include "models/linear_model.hpp"
-#include "models/sine_observation_noise.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -92,7 +91,8 @@ ExampleResult reproduce_basin_car_controller(const ReproduceSettings& settings, 
   car.x0_cov = Mat<2, 2>::zero();
   car.prior_mean = Vec<2>{{1.0, 0.1}};
   car.prior_cov = Mat<2, 2>{{{10.0, 1.0}, {1.0, 1.0}}};
-  const SineObservationNoise<CarTaylor3Model> sine(car);
+  CarTaylor3Model sine = car;
+  sine.sine_observation_noise = 1.0;
   QuadraticCost<2, 1> cost;  // (14) exactly: no 1/2 in this paper
   cost.F(0, 0) = 1.0;
   cost.target[0] = 10.0;
