@@ -96,9 +96,10 @@ struct EulerMaruyamaTruthStep {
     constexpr int p = Model::obs_dim, q = Model::noise_dim;
     Vec<p> zv = Vec<p>::zero();
     if (!sine_observation_noise(model))
-      zv = normals<p, Random123Draws>(RngKey{seed, Stream::observation_noise}, member, k);
-    advance_state(at, u, xm, normals<q, Random123Draws>(RngKey{seed, Stream::process_noise}, member, k), zv, next,
-                  increment);
+      zv = normal_vector<p>(RngKey{seed, Stream::observation_noise}, static_cast<std::uint32_t>(member), 0, k);
+    advance_state(at, u, xm,
+                  normal_vector<q>(RngKey{seed, Stream::process_noise}, static_cast<std::uint32_t>(member), 0, k), zv,
+                  next, increment);
     store(dy, member, increment);
     store(x, member, next);
   }
@@ -124,11 +125,8 @@ struct EulerMaruyamaTruthStep {
   /// Normals per member of a host chunk: process noise, then observation noise.
   static constexpr int lane_draws = Model::noise_dim + Model::obs_dim;
 
-  /// Host: the chunk's normals in SIMD lanes, z[k * host_member_chunk + member - begin] for normal k of lane_draws,
-  /// with the vectorizable Philox and glibc's vector log, sqrt, sin, cos (Box-Muller). A loop of its own, with no
-  /// model code in it, so that it vectorizes for every model: the draws are then the same bits for every model,
-  /// whether or not its step vectorizes (a model file's polynomial and the built-in model it equals give the same
-  /// numbers).
+  /// Host: the chunk's normals in SIMD lanes (draw_normal_lanes), z[k * host_member_chunk + member - begin] for
+  /// normal k of lane_draws.
   KUSHNER_FLATTEN void draw_lanes(const int begin, const int end, double* const z) const {
     constexpr int p = Model::obs_dim, q = Model::noise_dim;
     draw_lane_normals<q>(begin, end, RngKey{seed, Stream::process_noise}, z);
@@ -171,39 +169,17 @@ struct EulerMaruyamaTruthStep {
   }
 
  private:
-  /// N normals per member of the chunk from `key` into z[k * host_member_chunk + member - begin].
+  /// N normals per member of the chunk from `key` into z[k * host_member_chunk + member - begin]: normal_vector's
+  /// (blocks draw = 0 .. ceil(N/2) - 1 of (member, 0, step)).
   template <int N>
   void draw_lane_normals(const int begin, const int end, const RngKey& key, double* const z) const {
-    for (int i = 0; i < N; i += 2) {
-      KUSHNER_SIMD
-      for (int member = begin; member < end; ++member) {
-        const NormalPair pair = lane_normal_pair(key, member, step, i / 2);
-        z[i * host_member_chunk + member - begin] = pair.z0;
-        if (i + 1 < N) z[(i + 1) * host_member_chunk + member - begin] = pair.z1;
-      }
-    }
-  }
-  KOKKOS_INLINE_FUNCTION static NormalPair lane_normal_pair(const RngKey key, const int member,
-                                                            const std::uint32_t step, const int draw) {
-    double u0, u1;
-    SimdDraws::uniforms(key, Counter{static_cast<std::uint32_t>(member), 0, step, static_cast<std::uint32_t>(draw)}, u0,
-                        u1);
-    return box_muller(u0, u1);
-  }
-
- private:
-  /// normal_vector's normals (blocks draw = 0 .. ceil(N/2)-1 of (member, 0, step)) from Draws' uniforms.
-  template <int N, class Draws>
-  KOKKOS_INLINE_FUNCTION static Vec<N> normals(const RngKey& key, std::uint32_t member, std::uint32_t step) {
-    Vec<N> z;
-    for (int i = 0; i < N; i += 2) {
-      double u0, u1;
-      Draws::uniforms(key, Counter{member, 0, step, static_cast<std::uint32_t>(i / 2)}, u0, u1);
-      const NormalPair pair = box_muller(u0, u1);
-      z[i] = pair.z0;
-      if (i + 1 < N) z[i + 1] = pair.z1;
-    }
-    return z;
+    const std::uint32_t k = step;
+    draw_normal_lanes<N>(
+        begin, end, key,
+        [k](const int member, const int draw) {
+          return Counter{static_cast<std::uint32_t>(member), 0, k, static_cast<std::uint32_t>(draw)};
+        },
+        z, host_member_chunk);
   }
 };
 

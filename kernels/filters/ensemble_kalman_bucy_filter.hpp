@@ -20,10 +20,15 @@
 // Random numbers: initial ensemble from N(prior mean, prior cov) on Stream::filter_initial, process noise on
 // Stream::filter_noise, observation perturbations on Stream::filter_observation, each keyed by the run's seed with
 // counter {member, ensemble member, step}.
+// A GPU thread moves its member's ensemble one member after the other; on the host the ensemble members move in SIMD
+// lanes (move_in_lanes), their normals drawn first in a loop of their own (the same Philox numbers; glibc's vector
+// log, sin and cos, within a few ulp of libm's).
 #include "core/errors.hpp"
 #include "core/linear_algebra.hpp"
 #include "kernels/filters/filter_protocol.hpp"
 #include "kernels/filters/filter_step.hpp"
+#include "kernels/for_each_member.hpp"
+#include "kernels/particle_filter/particle_draws.hpp"
 #include "kernels/rng.hpp"
 
 #include <Kokkos_Core.hpp>
@@ -130,27 +135,30 @@ struct EnsembleKalmanBucyBase {
       const Vec<p> k = cholesky_solve(LS, row);
       for (int l = 0; l < p; ++l) K(i, l) = k[l];
     }
-    // Update and Euler-Maruyama step of every ensemble member; the new mean and covariance on the way.
+    // Update and Euler-Maruyama step of every ensemble member.
     const double sqrt_dt = math::sqrt(in.dt);
-    const auto u = Model::Control::zero();
     const RngKey noise_key{seed, Stream::filter_noise}, observation_key{seed, Stream::filter_observation};
-    Vec<n> sum = Vec<n>::zero();
-    for (int k = 0; k < N; ++k) {
-      Vec<n> x = load_member(member, k);
-      const Vec<p> hx = model.observation(in.t, x);
-      Vec<p> innovation;
-      if constexpr (Stochastic) {
-        const Vec<p> dv = normal_vector<p>(observation_key, who, static_cast<std::uint32_t>(k), step_index);
-        innovation = in.dy - hx * in.dt - LV * dv * sqrt_dt;
-      } else {
-        innovation = in.dy - (hx + h_bar) * (0.5 * in.dt);
-      }
-      x += K * innovation;
-      const Vec<q> dw = normal_vector<q>(noise_key, who, static_cast<std::uint32_t>(k), step_index);
-      x += model.drift(in.t, x, u) * in.dt + model.diffusion(in.t, x) * dw * sqrt_dt;
-      for (int i = 0; i < n; ++i) ensemble(member, k, i) = x[i];
-      sum += x;
+    bool moved = false;
+#if !KUSHNER_CUDA_DEVICE_PASS
+    if constexpr (Kokkos::SpaceAccessibility<Kokkos::HostSpace, MemSpace>::accessible) {
+      move_in_lanes(model, member, in, K, LV, h_bar, sqrt_dt, step_index);
+      moved = true;
     }
+#endif
+    if (!moved) {
+      for (int k = 0; k < N; ++k) {
+        Vec<n> x = load_member(member, k);
+        Vec<p> zv = Vec<p>::zero();
+        if constexpr (Stochastic)
+          zv = normal_vector<p>(observation_key, who, static_cast<std::uint32_t>(k), step_index);
+        const Vec<q> zw = normal_vector<q>(noise_key, who, static_cast<std::uint32_t>(k), step_index);
+        move(model, in, K, LV, h_bar, sqrt_dt, zv, zw, x);
+        for (int i = 0; i < n; ++i) ensemble(member, k, i) = x[i];
+      }
+    }
+    // The new mean and covariance.
+    Vec<n> sum = Vec<n>::zero();
+    for (int k = 0; k < N; ++k) sum += load_member(member, k);
     m = sum * (1.0 / N);
     Mat<n, n> cov = Mat<n, n>::zero();
     for (int k = 0; k < N; ++k) {
@@ -159,6 +167,65 @@ struct EnsembleKalmanBucyBase {
     }
     P = symmetrize(cov * (1.0 / (N - 1)));
     return Status::ok;
+  }
+
+ private:
+  /// One ensemble member's update with dy and its Euler-Maruyama step, given its normals: zv the observation
+  /// perturbation's (stochastic variant), zw the process noise's.
+  KOKKOS_INLINE_FUNCTION void move(const Model& model, const StepInput<p>& in, const Mat<n, p>& K, const Mat<p, p>& LV,
+                                   const Vec<p>& h_bar, const double sqrt_dt, const Vec<p>& zv, const Vec<q>& zw,
+                                   Vec<n>& x) const {
+    const Vec<p> hx = model.observation(in.t, x);
+    Vec<p> innovation;
+    if constexpr (Stochastic)
+      innovation = in.dy - hx * in.dt - LV * zv * sqrt_dt;
+    else
+      innovation = in.dy - (hx + h_bar) * (0.5 * in.dt);
+    x += K * innovation;
+    x += model.drift(in.t, x, Model::Control::zero()) * in.dt + model.diffusion(in.t, x) * zw * sqrt_dt;
+  }
+
+  /// Host: every ensemble member's move, host_member_chunk of them at a time in SIMD lanes: their normals first
+  /// (draw_normal_lanes: the same numbers as normal_vector, glibc's vector log, sin and cos), then the moves. The
+  /// stochastic EnKBF's scalar draws and drift (libm's log, cos, sin per ensemble member) took 62% of `kushner
+  /// compare`'s default run.
+  void move_in_lanes(const Model& model, const int member, const StepInput<p>& in, const Mat<n, p>& K,
+                     const Mat<p, p>& LV, const Vec<p>& h_bar, const double sqrt_dt,
+                     const std::uint32_t step_index) const {
+    constexpr int chunk = host_member_chunk;
+    const auto who = static_cast<std::uint32_t>(member);
+    const auto counter_of = [who, step_index](const int k, const int draw) {
+      return Counter{who, static_cast<std::uint32_t>(k), step_index, static_cast<std::uint32_t>(draw)};
+    };
+    double* const xs = &ensemble(member, 0, 0);  // raw: GCC does not vectorize a loop that reloads a View's pointer
+    const std::size_t k_stride = ensemble.stride(1), i_stride = ensemble.stride(2);
+    for (int begin = 0; begin < num_particles; begin += chunk) {
+      const int end = num_particles - begin < chunk ? num_particles : begin + chunk;
+      double z[(q + p) * chunk];
+      draw_normal_lanes<q>(begin, end, RngKey{seed, Stream::filter_noise}, counter_of, z, chunk);
+      if constexpr (Stochastic)
+        draw_normal_lanes<p>(begin, end, RngKey{seed, Stream::filter_observation}, counter_of, z + q * chunk, chunk);
+      KUSHNER_SIMD
+      for (int k = begin; k < end; ++k)
+        move_lane(model, in, K, LV, h_bar, sqrt_dt, xs + k * k_stride, i_stride, z + (k - begin));
+    }
+  }
+
+  /// move() of the ensemble member at x[i * i_stride] with its normals at z[j * host_member_chunk]: the loop body of
+  /// move_in_lanes as one call with scalar arguments (a Vec local to the body becomes an `omp simd` array, which
+  /// GCC does not vectorize).
+  KOKKOS_INLINE_FUNCTION void move_lane(const Model& model, const StepInput<p>& in, const Mat<n, p>& K,
+                                        const Mat<p, p>& LV, const Vec<p>& h_bar, const double sqrt_dt, double* const x,
+                                        const std::size_t i_stride, const double* const z) const {
+    Vec<n> xk;
+    Vec<q> zw;
+    Vec<p> zv = Vec<p>::zero();
+    for (int i = 0; i < n; ++i) xk[i] = x[i * i_stride];
+    for (int j = 0; j < q; ++j) zw[j] = z[j * host_member_chunk];
+    if constexpr (Stochastic)
+      for (int j = 0; j < p; ++j) zv[j] = z[(q + j) * host_member_chunk];
+    move(model, in, K, LV, h_bar, sqrt_dt, zv, zw, xk);
+    for (int i = 0; i < n; ++i) x[i * i_stride] = xk[i];
   }
 };
 

@@ -10,6 +10,7 @@
 // samplers stay fp64.
 #include "kernels/particle_filter/simd_random.hpp"
 #include "kernels/rng.hpp"
+#include "kernels/vector_math.hpp"
 
 #include <cstdint>
 
@@ -34,6 +35,31 @@ struct SimdDraws {
     simd::uniform_pair_fp32(key, c, u0, u1);
   }
 };
+
+/// Two normals from block c by the vectorizable Philox (SimdDraws) and box_muller: normal_pair's numbers.
+KOKKOS_INLINE_FUNCTION NormalPair simd_normal_pair(const RngKey key, const Counter c) {
+  double u0, u1;
+  SimdDraws::uniforms(key, c, u0, u1);
+  return box_muller(u0, u1);
+}
+
+/// Host: N normals for each lane of a SIMD loop over [begin, end), normal i of lane l at z[i * stride + l - begin]
+/// from block i / 2 of counter_of(l, i / 2) (so normal_vector's numbers where counter_of gives its counters), with
+/// glibc's vector log, sqrt, sin and cos. A loop of its own, with no model code in it, so that it vectorizes
+/// whatever the caller's step does: the draws are the same bits for every model, whether or not its step vectorizes
+/// (a model file's polynomial and the built-in model it equals give the same numbers).
+template <int N, class CounterOf>
+KUSHNER_FLATTEN void draw_normal_lanes(const int begin, const int end, const RngKey& key, const CounterOf& counter_of,
+                                       double* const z, const int stride) {
+  for (int i = 0; i < N; i += 2) {
+    KUSHNER_SIMD
+    for (int lane = begin; lane < end; ++lane) {
+      const NormalPair pair = simd_normal_pair(key, counter_of(lane, i / 2));
+      z[i * stride + lane - begin] = pair.z0;
+      if (i + 1 < N) z[(i + 1) * stride + lane - begin] = pair.z1;
+    }
+  }
+}
 
 /// Component i of the normals of particles 2 pair (z0) and 2 pair + 1 (z1) of `member` at `step`; in float
 /// with Fp32.
