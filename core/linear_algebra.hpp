@@ -103,6 +103,16 @@ KOKKOS_INLINE_FUNCTION double cholesky_quadratic_form(const Mat<N, N>& L, const 
   return s;
 }
 
+/// x^T A^{-1} x for a positive definite A whose Cholesky factor is L: x^2 / A for N = 1 (one division; L's square root
+/// is then left unused, and the compiler drops it), else cholesky_quadratic_form. Every filter's NEES at every step.
+template <int N>
+KOKKOS_INLINE_FUNCTION double inverse_quadratic_form(const Mat<N, N>& A, const Mat<N, N>& L, const Vec<N>& x) {
+  if constexpr (N == 1)
+    return x[0] * x[0] / A(0, 0);
+  else
+    return cholesky_quadratic_form(L, x);
+}
+
 /// log N(r; 0, R R^T), the Gaussian log density of a noise R d with d standard normal (R R^T positive definite;
 /// -inf when it is not).
 template <int N>

@@ -704,7 +704,10 @@ std::vector<MergedBlocks> FilterBank<ExecSpace, Model, TruthModel>::step_host_se
       for (const int b : plan.watched_blocks) segment.run_block(b, s, s + 1);
       if (plan.output_of[s] >= 0 && at_output) at_output(s);
     }
-    Kokkos::parallel_for("kushner::filter_bank_segment", Kokkos::RangePolicy<ExecSpace>(space_, 0, plan.num_blocks),
+    // Blocks handed out as threads free up: a thread slowed by anything else on its core no longer holds the others
+    // at the end of the segment (the rows are merged in block order, so the bits do not depend on who ran what).
+    Kokkos::parallel_for("kushner::filter_bank_segment",
+                         Kokkos::RangePolicy<ExecSpace, Kokkos::Schedule<Kokkos::Dynamic>>(space_, 0, plan.num_blocks),
                          segment);
     space_.fence();
     merged = merge_segment_rows(segment_rows_.data(), plan);

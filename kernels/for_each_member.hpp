@@ -35,6 +35,11 @@ namespace kushner {
 /// Members per host work item: small enough that 200 members keep 2 threads busy, large enough for SIMD.
 constexpr int host_member_chunk = 32;
 
+/// The end of the host chunk that starts at `begin`, of members that end at `end`.
+KOKKOS_INLINE_FUNCTION constexpr int host_chunk_end(const int begin, const int end) {
+  return end - begin < host_member_chunk ? end : begin + host_member_chunk;
+}
+
 namespace detail {
 template <class Functor, class = void>
 struct has_run_chunk : std::false_type {};
@@ -60,7 +65,7 @@ struct MemberChunks {
   int members;
   void operator()(const int chunk) const {
     const int begin = chunk * host_member_chunk;
-    run_member_chunk(f, begin, members - begin < host_member_chunk ? members : begin + host_member_chunk);
+    run_member_chunk(f, begin, host_chunk_end(begin, members));
   }
 };
 

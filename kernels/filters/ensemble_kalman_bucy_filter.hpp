@@ -141,7 +141,7 @@ struct EnsembleKalmanBucyBase {
     bool moved = false;
 #if !KUSHNER_CUDA_DEVICE_PASS
     if constexpr (Kokkos::SpaceAccessibility<Kokkos::HostSpace, MemSpace>::accessible) {
-      move_in_lanes(model, member, in, K, LV, h_bar, sqrt_dt, step_index);
+      move_in_lanes(model, member, in, K, LV, h_bar, sqrt_dt, noise_key, observation_key, who, step_index);
       moved = true;
     }
 #endif
@@ -190,21 +190,19 @@ struct EnsembleKalmanBucyBase {
   /// stochastic EnKBF's scalar draws and drift (libm's log, cos, sin per ensemble member) took 62% of `kushner
   /// compare`'s default run.
   void move_in_lanes(const Model& model, const int member, const StepInput<p>& in, const Mat<n, p>& K,
-                     const Mat<p, p>& LV, const Vec<p>& h_bar, const double sqrt_dt,
-                     const std::uint32_t step_index) const {
+                     const Mat<p, p>& LV, const Vec<p>& h_bar, const double sqrt_dt, const RngKey& noise_key,
+                     const RngKey& observation_key, const std::uint32_t who, const std::uint32_t step_index) const {
     constexpr int chunk = host_member_chunk;
-    const auto who = static_cast<std::uint32_t>(member);
     const auto counter_of = [who, step_index](const int k, const int draw) {
       return Counter{who, static_cast<std::uint32_t>(k), step_index, static_cast<std::uint32_t>(draw)};
     };
     double* const xs = &ensemble(member, 0, 0);  // raw: GCC does not vectorize a loop that reloads a View's pointer
     const std::size_t k_stride = ensemble.stride(1), i_stride = ensemble.stride(2);
     for (int begin = 0; begin < num_particles; begin += chunk) {
-      const int end = num_particles - begin < chunk ? num_particles : begin + chunk;
+      const int end = host_chunk_end(begin, num_particles);
       double z[(q + p) * chunk];
-      draw_normal_lanes<q>(begin, end, RngKey{seed, Stream::filter_noise}, counter_of, z, chunk);
-      if constexpr (Stochastic)
-        draw_normal_lanes<p>(begin, end, RngKey{seed, Stream::filter_observation}, counter_of, z + q * chunk, chunk);
+      draw_normal_lanes<q>(begin, end, noise_key, counter_of, z, chunk);
+      if constexpr (Stochastic) draw_normal_lanes<p>(begin, end, observation_key, counter_of, z + q * chunk, chunk);
       KUSHNER_SIMD
       for (int k = begin; k < end; ++k)
         move_lane(model, in, K, LV, h_bar, sqrt_dt, xs + k * k_stride, i_stride, z + (k - begin));

@@ -77,7 +77,7 @@ struct FilterBankSegment {
       step.truth.step = static_cast<std::uint32_t>(k);
       step.record = output_of[s] >= 0;
       for (int chunk = begin; chunk < end; chunk += host_member_chunk)
-        run_member_chunk(step, chunk, end - chunk < host_member_chunk ? end : chunk + host_member_chunk);
+        run_member_chunk(step, chunk, host_chunk_end(chunk, end));
       if (output_of[s] < 0) continue;
       double* const row = rows + (static_cast<std::size_t>(output_of[s]) * num_blocks + b) * width;
       for (int c = 0; c < num_columns; ++c) {
@@ -183,7 +183,7 @@ struct FilterBankTeamSegment {
 #if !KUSHNER_CUDA_DEVICE_PASS
     if constexpr (Kokkos::SpaceAccessibility<Kokkos::HostSpace, MemSpace>::accessible)
       for (int chunk = begin; chunk < end; chunk += host_member_chunk)
-        run_member_chunk(step, chunk, end - chunk < host_member_chunk ? end : chunk + host_member_chunk);
+        run_member_chunk(step, chunk, host_chunk_end(chunk, end));
 #endif
   }
 

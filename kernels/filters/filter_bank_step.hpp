@@ -244,7 +244,7 @@ struct EstimatorScore {
     const Mat<N, N> P = load_symmetric<N>(slot.P, member);
     Mat<N, N> L;
     const Definiteness definiteness = semidefinite_cholesky(P, L, covariance_tolerance);
-    score_member(slot, member, load<N>(truth, member), load<N>(slot.m, member), L, definiteness, record);
+    score_member(slot, member, load<N>(truth, member), load<N>(slot.m, member), P, L, definiteness, record);
     if (reference.extent(0) > 0)
       score_reference<N>(slot, member, reference, reference_status(member) == Status::ok, record);
   }

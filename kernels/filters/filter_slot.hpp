@@ -60,12 +60,12 @@ KOKKOS_INLINE_FUNCTION ScoreSums load_score_sums(const Slot& s, int member) {
 /// member's score sums before this point (load_score_sums).
 template <int N, class Slot>
 KOKKOS_INLINE_FUNCTION void score_member(const Slot& s, int member, const Vec<N>& x, const Vec<N>& m,
-                                         const Mat<N, N>& L, Definiteness definiteness, bool record,
+                                         const Mat<N, N>& P, const Mat<N, N>& L, Definiteness definiteness, bool record,
                                          const ScoreSums& sums) {
   const Vec<N> e = m - x;
   const double squared_error = dot(e, e);
   const bool has_nees = definiteness == Definiteness::positive_definite;
-  const double nees = has_nees ? cholesky_quadratic_form(L, e) : math::quiet_nan();
+  const double nees = has_nees ? inverse_quadratic_form(P, L, e) : math::quiet_nan();
   s.score(member, squared_error_sum) = sums.squared_error + squared_error;
   if (has_nees) {
     s.score(member, nees_sum) = sums.nees + nees;
@@ -79,8 +79,9 @@ KOKKOS_INLINE_FUNCTION void score_member(const Slot& s, int member, const Vec<N>
 
 template <int N, class Slot>
 KOKKOS_INLINE_FUNCTION void score_member(const Slot& s, int member, const Vec<N>& x, const Vec<N>& m,
-                                         const Mat<N, N>& L, Definiteness definiteness, bool record) {
-  score_member(s, member, x, m, L, definiteness, record, load_score_sums(s, member));
+                                         const Mat<N, N>& P, const Mat<N, N>& L, Definiteness definiteness,
+                                         bool record) {
+  score_member(s, member, x, m, P, L, definiteness, record, load_score_sums(s, member));
 }
 
 template <class Slot>
@@ -158,9 +159,9 @@ KOKKOS_INLINE_FUNCTION void advance(const FilterSlot<Filter, MemSpace>& s, const
   store(s.m, member, m);
   store_symmetric(s.P, member, P);
   if constexpr (speculative)
-    score_member(s, member, x, m, L, definiteness, record, sums);
+    score_member(s, member, x, m, P, L, definiteness, record, sums);
   else
-    score_member(s, member, x, m, L, definiteness, record);
+    score_member(s, member, x, m, P, L, definiteness, record);
 }
 
 /// advance() of one member as one lane of a host loop over members in SIMD lanes (FilterBankStep::run_chunk): the
@@ -218,7 +219,7 @@ KOKKOS_INLINE_FUNCTION std::int64_t advance_lane(const Filter& filter, const Mod
   const double squared_error = dot(e, e);
   const bool has_nees = good && definiteness == Definiteness::positive_definite;
   const double nan = math::quiet_nan();
-  const double nees = has_nees ? cholesky_quadratic_form(L, e) : nan;
+  const double nees = has_nees ? inverse_quadratic_form(P, L, e) : nan;
   double& sum = score[member + squared_error_sum * score_stride];
   double& nees_total = score[member + nees_sum * score_stride];
   double& points = score[member + nees_points * score_stride];
@@ -237,7 +238,7 @@ KOKKOS_INLINE_FUNCTION void score_initial(const FilterSlot<Filter, MemSpace>& s,
   const Mat<N, N> P = load_symmetric<N>(s.P, member);
   Mat<N, N> L;
   const Definiteness definiteness = semidefinite_cholesky(P, L, covariance_tolerance);
-  score_member(s, member, x, load<N>(s.m, member), L, definiteness, true);
+  score_member(s, member, x, load<N>(s.m, member), P, L, definiteness, true);
 }
 
 /// |m - m_ref|^2 against a reference mean (e.g. a particle filter's posterior mean) of the same member.
