@@ -50,15 +50,9 @@ KOKKOS_INLINE_FUNCTION bool discrete_covariance_update(const Model& model, const
   const double k1 = in.t + 1.0;
   const Mat<p, n> H = model.observation_jacobian(k1, m);
   const Mat<n, p> PHt = P * transpose(H);
-  Mat<p, p> L;
-  if (!cholesky(in.V + H * PHt, L)) return false;
-  Mat<n, p> K;  // P H^T S^-1, row by row
-  for (int i = 0; i < n; ++i) {
-    Vec<p> row;
-    for (int l = 0; l < p; ++l) row[l] = PHt(i, l);
-    const Vec<p> gain = cholesky_solve(L, row);
-    for (int l = 0; l < p; ++l) K(i, l) = gain[l];
-  }
+  PositiveDefiniteSolver<p> solver;
+  if (!solver.factor(in.V + H * PHt)) return false;
+  const Mat<n, p> K = solver.right_solve(PHt);  // P H^T S^-1
   m += K * (in.dy - model.observation(k1, m));
   const Mat<n, n> I_KH = Mat<n, n>::identity() - K * H;
   P = symmetrize(I_KH * P * transpose(I_KH) + K * in.V * transpose(K));

@@ -126,15 +126,10 @@ struct EnsembleKalmanBucyBase {
     Pxh = Pxh * (1.0 / (N - 1));
     Phh = Phh * (1.0 / (N - 1));
     const Mat<p, p> S = in.V + Phh * in.dt;
-    Mat<p, p> LS, LV;
-    if (!cholesky(S, LS) || !cholesky(in.V, LV)) return Status::not_positive_definite;
-    Mat<n, p> K;  // P^{xh} S^{-1}, row by row
-    for (int i = 0; i < n; ++i) {
-      Vec<p> row;
-      for (int l = 0; l < p; ++l) row[l] = Pxh(i, l);
-      const Vec<p> k = cholesky_solve(LS, row);
-      for (int l = 0; l < p; ++l) K(i, l) = k[l];
-    }
+    PositiveDefiniteSolver<p> solver;
+    Mat<p, p> LV;
+    if (!solver.factor(S) || !cholesky(in.V, LV)) return Status::not_positive_definite;
+    const Mat<n, p> K = solver.right_solve(Pxh);  // P^{xh} S^{-1}
     // Update and Euler-Maruyama step of every ensemble member.
     const double sqrt_dt = math::sqrt(in.dt);
     const RngKey noise_key{seed, Stream::filter_noise}, observation_key{seed, Stream::filter_observation};

@@ -86,16 +86,10 @@ struct UnscentedKalmanFilter {
       Chh += (outer(hp, hp) + outer(hm, hm)) * wj;
     }
     const Mat<p, p> S = in.V + Chh * in.dt;
-    Mat<p, p> LS;
-    if (!cholesky(S, LS)) return Status::not_positive_definite;
+    PositiveDefiniteSolver<p> solver;
+    if (!solver.factor(S)) return Status::not_positive_definite;
     const Vec<p> innovation = in.dy - h_bar * in.dt;
-    Mat<n, p> K;  // C_xh S^{-1}, row by row
-    for (int i = 0; i < n; ++i) {
-      Vec<p> row;
-      for (int l = 0; l < p; ++l) row[l] = Cxh(i, l);
-      const Vec<p> k = cholesky_solve(LS, row);
-      for (int l = 0; l < p; ++l) K(i, l) = k[l];
-    }
+    const Mat<n, p> K = solver.right_solve(Cxh);  // C_xh S^{-1}
     m += K * innovation;
     P = symmetrize(P - (K * transpose(Cxh)) * in.dt);
     // 2. Prediction through the Euler map.
