@@ -53,15 +53,18 @@ struct PriorLineStep {
     const int nodes = static_cast<int>(x.extent(0));
     const Vec<p> dym = load<p>(dy, member);
     const Mat<p, p> V = model.observation_noise(t) * transpose(model.observation_noise(t));
-    Mat<p, p> L;
-    cholesky(V, L);
+    PositiveDefiniteSolver<p> V_solver;
+    if (!V_solver.factor(V)) {
+      status(member) = Status::not_positive_definite;
+      return;
+    }
     const typename Model::Control u = Model::Control::zero();
     double largest = -1e300;
     for (int j = 0; j < nodes; ++j) {
       Vec<n> xj;
       for (int i = 0; i < n; ++i) xj[i] = x(j, member, i);
       const Vec<p> h = model.observation(t, xj);
-      const Vec<p> Vinv_h = cholesky_solve(L, h);
+      const Vec<p> Vinv_h = V_solver.solve(h);
       const double lw = log_weight(j, member) + dot(Vinv_h, dym) - 0.5 * dot(Vinv_h, h) * dt;
       log_weight(j, member) = lw;
       largest = lw > largest ? lw : largest;

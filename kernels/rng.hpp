@@ -13,8 +13,9 @@
 // The fp32 variant (the particle filter's `mixed` precision) takes 23-bit uniforms from the same blocks' high
 // words (the top bits of the 52-bit ones) and runs Box-Muller in float: the same normals to about 1e-7,
 // with the radius cut at sqrt(48 ln 2) = 5.77 (probability 2^-24 beyond it).
-// The truths take component i of their N normals from block i / 2 (normal_vector); the particle filter
-// gives both normals of a block to two particles (kernels/particle_filter/particle_draws.hpp).
+// The truths take component i of their N normals from block i / 2 (normal_vector; a continuous-time truth's
+// observation and process normals are one vector of the process-noise stream: observation_and_process_normals);
+// the particle filter gives both normals of a block to two particles (kernels/particle_filter/particle_draws.hpp).
 #include "core/math.hpp"
 #include "core/small_matrix.hpp"
 
@@ -29,14 +30,15 @@ namespace kushner {
 /// (changing one changes every number a seed gives), so they never change.
 enum class Stream : std::uint32_t {
   truth_initial = 1,       // initial states of the truths
-  process_noise = 2,       // dw of the truths
-  observation_noise = 3,   // dv of the observations
+  process_noise = 2,       // dw of the truths (and before it a continuous-time truth's dv)
+  observation_noise = 3,   // dv of the discrete-time truths' observations
   particle_initial = 4,    // initial particles
   particle_noise = 5,      // dw of the particles
   resampling = 6,          // uniforms of the resampling schemes
   filter_initial = 7,      // randomized filter initial conditions (the EnKBF's initial ensemble)
-  filter_noise = 8,        // dw of a randomized filter's members (EnKBF)
-  filter_observation = 9,  // perturbed observations of a randomized filter (the stochastic EnKBF)
+  filter_noise = 8,        // dw of a randomized filter's members (EnKBF), and before it the stochastic EnKBF's
+                           // perturbed observations (observation_and_process_normals)
+  filter_observation = 9,  // unused since the stochastic EnKBF's perturbations share filter_noise's blocks
 };
 
 /// The run's seed and the global index of this process's first member: a process running members
@@ -149,6 +151,20 @@ KOKKOS_INLINE_FUNCTION Vec<N> normal_vector(const RngKey& key, std::uint32_t mem
     if (i + 1 < N) z[i + 1] = z1;
   }
   return z;
+}
+
+/// The P observation normals v and the Q process normals w of one (member, particle, step) as one vector of `key`'s
+/// blocks, v first (normal_vector<P + Q>): where P and Q are both odd, one block and one Box-Muller pair serve the
+/// last of v and the first of w. v first, so that a model whose noise is padded with columns of zeros (a model
+/// file's Q is its state dimension) draws the numbers of the model without them. The truths and the stochastic
+/// EnKBF's ensemble members draw so.
+template <int P, int Q>
+KOKKOS_INLINE_FUNCTION void observation_and_process_normals(const RngKey& key, std::uint32_t member,
+                                                            std::uint32_t particle, std::uint32_t step, Vec<P>& v,
+                                                            Vec<Q>& w) {
+  const Vec<P + Q> z = normal_vector<P + Q>(key, member, particle, step);
+  for (int i = 0; i < P; ++i) v[i] = z[i];
+  for (int i = 0; i < Q; ++i) w[i] = z[P + i];
 }
 
 /// N uniforms in (0, 1) for one (member, particle, step): blocks draw = 0 .. ceil(N/2)-1.

@@ -72,6 +72,10 @@ KOKKOS_INLINE_FUNCTION void step_stored_state(const Truth& truth, const int memb
 /// with u = 0 (open loop) or, in a closed loop, the member's control (step_member). The draws depend on seed,
 /// member and step only, so every controller's loop sees the same noise (common random numbers); or
 /// dv = cos t - cos(t + dt) where the model's observation noise is the sine path (sine_observation_noise).
+/// A step's p observation and q process normals are one vector, v then w, of the process-noise stream
+/// (observation_and_process_normals): where p and q are both odd a Philox block and a Box-Muller pair serve the last
+/// of v and the first of w (the sine model: one block, one log and one square root per member-step instead of two
+/// each). v is drawn with sine observation noise too (and not used), so the state paths are the same for both.
 template <class Model, class MemSpace>
 struct EulerMaruyamaTruthStep {
   Model model;
@@ -94,12 +98,12 @@ struct EulerMaruyamaTruthStep {
                                         const typename Model::Control& u, const Vec<Model::state_dim>& xm,
                                         Vec<Model::state_dim>& next, Vec<Model::obs_dim>& increment) const {
     constexpr int p = Model::obs_dim, q = Model::noise_dim;
-    Vec<p> zv = Vec<p>::zero();
-    if (!sine_observation_noise(model))
-      zv = normal_vector<p>(RngKey{seed, Stream::observation_noise}, static_cast<std::uint32_t>(member), 0, k);
-    advance_state(at, u, xm,
-                  normal_vector<q>(RngKey{seed, Stream::process_noise}, static_cast<std::uint32_t>(member), 0, k), zv,
-                  next, increment);
+    const RngKey key{seed, Stream::process_noise};
+    const auto who = static_cast<std::uint32_t>(member);
+    Vec<p> zv;
+    Vec<q> zw;
+    observation_and_process_normals<p, q>(key, who, 0, k, zv, zw);  // zv unused with sine observation noise
+    advance_state(at, u, xm, zw, zv, next, increment);
     store(dy, member, increment);
     store(x, member, next);
   }
@@ -122,16 +126,13 @@ struct EulerMaruyamaTruthStep {
     next = xm + model.drift(at, xm, u) * dt + model.diffusion(at, xm) * dw;
   }
 
-  /// Normals per member of a host chunk: process noise, then observation noise.
-  static constexpr int lane_draws = Model::noise_dim + Model::obs_dim;
+  /// Normals per member of a host chunk: observation noise, then process noise (observation_and_process_normals').
+  static constexpr int lane_draws = Model::obs_dim + Model::noise_dim;
 
   /// Host: the chunk's normals in SIMD lanes (draw_normal_lanes), z[k * host_member_chunk + member - begin] for
   /// normal k of lane_draws.
   KUSHNER_FLATTEN void draw_lanes(const int begin, const int end, double* const z) const {
-    constexpr int p = Model::obs_dim, q = Model::noise_dim;
-    draw_lane_normals<q>(begin, end, RngKey{seed, Stream::process_noise}, z);
-    if (!sine_observation_noise(model))
-      draw_lane_normals<p>(begin, end, RngKey{seed, Stream::observation_noise}, z + q * host_member_chunk);
+    draw_lane_normals<lane_draws>(begin, end, RngKey{seed, Stream::process_noise}, z);
   }
 
   /// Host: the members of one chunk in SIMD lanes (kernels/for_each_member.hpp's run_member_chunk): the draws
@@ -160,8 +161,8 @@ struct EulerMaruyamaTruthStep {
     Vec<p> increment, zv;
     Vec<q> zw;
     for (int i = 0; i < n; ++i) xm[i] = xs[member + i * x_stride];
-    for (int k = 0; k < q; ++k) zw[k] = z[k * host_member_chunk];
-    for (int k = 0; k < p; ++k) zv[k] = z[(q + k) * host_member_chunk];
+    for (int k = 0; k < p; ++k) zv[k] = z[k * host_member_chunk];
+    for (int k = 0; k < q; ++k) zw[k] = z[(p + k) * host_member_chunk];
     advance_state(t, Model::Control::zero(), xm, zw, zv, next, increment);
     for (int i = 0; i < p; ++i) dys[member + i * dy_stride] = ok ? increment[i] : dys[member + i * dy_stride];
     for (int i = 0; i < n; ++i) xs[member + i * x_stride] = ok ? next[i] : xm[i];

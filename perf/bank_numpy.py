@@ -16,8 +16,8 @@ kernels/filters/filter_bank_step.hpp do it:
                                                a = -sin(m) e^{-P/2},           J = -cos(m) e^{-P/2}
     KBL (linearized_kalman_bucy_filter.hpp):   a = -m,                         J = -1            (at the origin)
 Timed, the bank draws from NumPy's default generator. With --philox it draws kushner's own numbers instead
-(Philox4x32-10 keyed by {seed, stream}, counter {member, 0, step, 0}, 52-bit uniforms, Box-Muller: kernels/rng.hpp),
-so it sees the very noise `kushner filter --seed S` sees, and --check DIR (a kushner filter run's summary.json with
+(Philox4x32-10 keyed by {seed, stream}, counter {member, 0, step, 0}, 52-bit uniforms, Box-Muller: kernels/rng.hpp;
+a truth's dv is the first normal of its step's block of the process-noise stream and dw the second), so it sees the very noise `kushner filter --seed S` sees, and --check DIR (a kushner filter run's summary.json with
 the same M, T, dt and seed) compares every filter's rmse_truth and nees: they agree to rounding (libm vs NumPy's
 sin/cos/exp/log, and P / S vs kushner's P (1 / S)). --metrics computes kushner's rmse_truth (root of
 the time-and-ensemble mean of (m - x)^2 over the time points 0, dt, ..., T, delta-method standard error) and nees.
@@ -36,12 +36,12 @@ import numpy as np
 
 Q, R = 1.0, 0.5
 FILTERS = ("EKF", "SOF", "QLF", "KBL")
-TRUTH_INITIAL, PROCESS_NOISE, OBSERVATION_NOISE = 1, 2, 3  # kernels/rng.hpp's Stream values
+TRUTH_INITIAL, PROCESS_NOISE = 1, 2  # kernels/rng.hpp's Stream values
 MASK = np.uint64(0xFFFFFFFF)
 
 
 def philox_normals(seed, stream, members, step):
-    """kushner's first normal of block {member, 0, step, 0} of key {seed, stream} for every member."""
+    """kushner's two normals of block {member, 0, step, 0} of key {seed, stream} for every member."""
     c0 = np.arange(members, dtype=np.uint64)
     c1 = np.zeros(members, dtype=np.uint64)
     c2 = np.full(members, step, dtype=np.uint64)
@@ -56,7 +56,8 @@ def philox_normals(seed, stream, members, step):
     def uniform(hi, lo):
         return ((((hi << np.uint64(32)) | lo) >> np.uint64(12)).astype(np.float64) + 0.5) * 2.0**-52
     u0, u1 = uniform(c0, c1), uniform(c2, c3)
-    return np.sqrt(-2.0 * np.log(u0)) * np.cos(2.0 * np.pi * u1)
+    radius = np.sqrt(-2.0 * np.log(u0))
+    return radius * np.cos(2.0 * np.pi * u1), radius * np.sin(2.0 * np.pi * u1)
 
 
 def run_bank(members, T, dt, seed, metrics=False, philox=False):
@@ -65,7 +66,7 @@ def run_bank(members, T, dt, seed, metrics=False, philox=False):
     steps = int(round(T / dt))
     sq = np.sqrt(dt)
     V, W = R * R, Q * Q * dt
-    x = 1.0 + (philox_normals(seed, TRUTH_INITIAL, members, 0) if philox else rng.standard_normal(members))
+    x = 1.0 + (philox_normals(seed, TRUTH_INITIAL, members, 0)[0] if philox else rng.standard_normal(members))
     m = {f: np.full(members, 1.0) for f in FILTERS}
     P = {f: np.full(members, 1.0) for f in FILTERS}
     dw, dv, dy = np.empty(members), np.empty(members), np.empty(members)
@@ -76,8 +77,7 @@ def run_bank(members, T, dt, seed, metrics=False, philox=False):
     start = time.perf_counter()
     for step in range(steps):
         if philox:
-            dw[:] = philox_normals(seed, PROCESS_NOISE, members, step)
-            dv[:] = philox_normals(seed, OBSERVATION_NOISE, members, step)
+            dv[:], dw[:] = philox_normals(seed, PROCESS_NOISE, members, step)
         else:
             rng.standard_normal(out=dw)
             rng.standard_normal(out=dv)

@@ -21,6 +21,7 @@
 #include <cmath>
 #include <cstdint>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <string>
@@ -100,6 +101,11 @@ struct RunSpec {
   long members = 200, particles = 512, steps = 1000;  // particles 0: the truths are the reference
   double dt = 0.01;
   std::uint32_t seed = 20261125;
+  // A truth whose first coordinate ends farther than this from 0 has escaped (the cubic oscillator's, past the
+  // barrier of its potential at |x1| = sqrt(8), leaves the numbers in finite time): its member is dropped like one
+  // that has left them already. There every estimate trails a path that runs off, by the same ~1e2 (the ranking's
+  // differences elsewhere are ~1e-2), so one such member decides the paired standard error.
+  double escape_radius = std::numeric_limits<double>::infinity();
 };
 
 template <class Model>
@@ -130,8 +136,10 @@ MemberErrors run_against_reference(const Model& model, const std::vector<std::st
   Space().fence();
   MemberErrors out;
   const auto ref_status = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), base->status());
+  const auto truth = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bank.truths().state());
   std::vector<char> ok(spec.members, 1);
-  for (long m = 0; m < spec.members; ++m) ok[m] = ref_status(m) == Status::ok;
+  for (long m = 0; m < spec.members; ++m)
+    ok[m] = ref_status(m) == Status::ok && std::abs(truth(m, 0)) <= spec.escape_radius;
   std::map<std::string, Kokkos::View<double**, Kokkos::LayoutLeft, Kokkos::HostSpace>> scores;
   for (const auto& name : filters) {
     const std::vector<char> filter_ok = bank.members_ok(name);
@@ -214,10 +222,11 @@ TEST(FilterRanking, SineHardRegimeQlfSofEkf) {
   expect_ranking(model, {"QLF", "SOF", "EKF"}, spec);
 }
 
-/// Seed 000 Example 2 (q = r = 0.5, truths from (1.5, 1), filters from N(0, I)), T = 5, 200 members.
+/// Seed 000 Example 2 (q = r = 0.5, truths from (1.5, 1), filters from N(0, I)), T = 5, 200 members; a truth
+/// that ends past |x1| = 10 has escaped (RunSpec::escape_radius).
 TEST(FilterRanking, CubicOscillatorQlfSofEkf) {
   RunSpec spec;
-  spec.members = 200, spec.steps = 500;
+  spec.members = 200, spec.steps = 500, spec.escape_radius = 10.0;
   expect_ranking(CubicOscillatorModel{}, {"QLF", "SOF", "EKF"}, spec);
 }
 

@@ -17,9 +17,9 @@
 // stochastic variant's mean and covariance equal the Kalman-Bucy step's in expectation, so as N grows it tends to
 // Kalman-Bucy with Monte Carlo error of order N^{-1/2}; the deterministic one has the same limit up to O(dt) (its
 // half-gain step contracts the spread by (I - dt K H / 2)^2, not I - dt K H).
-// Random numbers: initial ensemble from N(prior mean, prior cov) on Stream::filter_initial, process noise on
-// Stream::filter_noise, observation perturbations on Stream::filter_observation, each keyed by the run's seed with
-// counter {member, ensemble member, step}.
+// Random numbers: initial ensemble from N(prior mean, prior cov) on Stream::filter_initial, process noise (and
+// before it, in the stochastic variant, the observation perturbation: observation_and_process_normals) on
+// Stream::filter_noise, each keyed by the run's seed with counter {member, ensemble member, step}.
 // A GPU thread moves its member's ensemble one member after the other; on the host the ensemble members move in SIMD
 // lanes (move_in_lanes), their normals drawn first in a loop of their own (the same Philox numbers; glibc's vector
 // log, sin and cos, within a few ulp of libm's).
@@ -132,21 +132,24 @@ struct EnsembleKalmanBucyBase {
     const Mat<n, p> K = solver.right_solve(Pxh);  // P^{xh} S^{-1}
     // Update and Euler-Maruyama step of every ensemble member.
     const double sqrt_dt = math::sqrt(in.dt);
-    const RngKey noise_key{seed, Stream::filter_noise}, observation_key{seed, Stream::filter_observation};
+    const RngKey noise_key{seed, Stream::filter_noise};
     bool moved = false;
 #if !KUSHNER_CUDA_DEVICE_PASS
     if constexpr (Kokkos::SpaceAccessibility<Kokkos::HostSpace, MemSpace>::accessible) {
-      move_in_lanes(model, member, in, K, LV, h_bar, sqrt_dt, noise_key, observation_key, who, step_index);
+      move_in_lanes(model, member, in, K, LV, h_bar, sqrt_dt, noise_key, who, step_index);
       moved = true;
     }
 #endif
     if (!moved) {
       for (int k = 0; k < N; ++k) {
         Vec<n> x = load_member(member, k);
+        const auto ensemble_member = static_cast<std::uint32_t>(k);
         Vec<p> zv = Vec<p>::zero();
+        Vec<q> zw;
         if constexpr (Stochastic)
-          zv = normal_vector<p>(observation_key, who, static_cast<std::uint32_t>(k), step_index);
-        const Vec<q> zw = normal_vector<q>(noise_key, who, static_cast<std::uint32_t>(k), step_index);
+          observation_and_process_normals<p, q>(noise_key, who, ensemble_member, step_index, zv, zw);
+        else
+          zw = normal_vector<q>(noise_key, who, ensemble_member, step_index);
         move(model, in, K, LV, h_bar, sqrt_dt, zv, zw, x);
         for (int i = 0; i < n; ++i) ensemble(member, k, i) = x[i];
       }
@@ -186,8 +189,9 @@ struct EnsembleKalmanBucyBase {
   /// compare`'s default run.
   void move_in_lanes(const Model& model, const int member, const StepInput<p>& in, const Mat<n, p>& K,
                      const Mat<p, p>& LV, const Vec<p>& h_bar, const double sqrt_dt, const RngKey& noise_key,
-                     const RngKey& observation_key, const std::uint32_t who, const std::uint32_t step_index) const {
+                     const std::uint32_t who, const std::uint32_t step_index) const {
     constexpr int chunk = host_member_chunk;
+    constexpr int draws = Stochastic ? p + q : q;  // observation_and_process_normals' (v, then w), or w alone
     const auto counter_of = [who, step_index](const int k, const int draw) {
       return Counter{who, static_cast<std::uint32_t>(k), step_index, static_cast<std::uint32_t>(draw)};
     };
@@ -195,9 +199,8 @@ struct EnsembleKalmanBucyBase {
     const std::size_t k_stride = ensemble.stride(1), i_stride = ensemble.stride(2);
     for (int begin = 0; begin < num_particles; begin += chunk) {
       const int end = host_chunk_end(begin, num_particles);
-      double z[(q + p) * chunk];
-      draw_normal_lanes<q>(begin, end, noise_key, counter_of, z, chunk);
-      if constexpr (Stochastic) draw_normal_lanes<p>(begin, end, observation_key, counter_of, z + q * chunk, chunk);
+      double z[draws * chunk];
+      draw_normal_lanes<draws>(begin, end, noise_key, counter_of, z, chunk);
       KUSHNER_SIMD
       for (int k = begin; k < end; ++k)
         move_lane(model, in, K, LV, h_bar, sqrt_dt, xs + k * k_stride, i_stride, z + (k - begin));
@@ -214,9 +217,10 @@ struct EnsembleKalmanBucyBase {
     Vec<q> zw;
     Vec<p> zv = Vec<p>::zero();
     for (int i = 0; i < n; ++i) xk[i] = x[i * i_stride];
-    for (int j = 0; j < q; ++j) zw[j] = z[j * host_member_chunk];
+    constexpr int w_first = Stochastic ? p : 0;  // move_in_lanes' draws: v, then w; or w alone
     if constexpr (Stochastic)
-      for (int j = 0; j < p; ++j) zv[j] = z[(q + j) * host_member_chunk];
+      for (int j = 0; j < p; ++j) zv[j] = z[j * host_member_chunk];
+    for (int j = 0; j < q; ++j) zw[j] = z[(w_first + j) * host_member_chunk];
     move(model, in, K, LV, h_bar, sqrt_dt, zv, zw, xk);
     for (int i = 0; i < n; ++i) x[i * i_stride] = xk[i];
   }

@@ -122,7 +122,7 @@ TEST(EnsembleKalmanBucyFilter, SameSeedSameNumbersOtherSeedOthers) {
 
 /// One step of ensemble filter Filter (host) for member 1 of 3, against the step written out: the statistics, the
 /// gain, then each ensemble member's update with its own normals (counter {member, ensemble member, step}: process
-/// noise on Stream::filter_noise, the perturbation on Stream::filter_observation), libm's sin and log. 37 ensemble
+/// noise after the perturbation, on Stream::filter_noise), libm's sin and log. 37 ensemble
 /// members: a chunk of 32 lanes and a remainder. Returns the largest difference relative to the value's scale.
 template <template <class, class> class Filter, class Model>
 double largest_difference_from_written_out_step(const Model& model) {
@@ -173,9 +173,15 @@ double largest_difference_from_written_out_step(const Model& model) {
   Vec<n> sum = Vec<n>::zero();
   for (int k = 0; k < N; ++k) {
     const auto ensemble_member = static_cast<std::uint32_t>(k);
-    const Vec<Model::noise_dim> zw =
-        normal_vector<Model::noise_dim>(RngKey{11, Stream::filter_noise}, member, ensemble_member, step);
-    const Vec<p> zv = normal_vector<p>(RngKey{11, Stream::filter_observation}, member, ensemble_member, step);
+    // The filter-noise stream's normals of (member, ensemble member, step): the stochastic variant's observation
+    // perturbation, then dw; the deterministic variant's dw alone.
+    constexpr int q = Model::noise_dim, v_count = stochastic ? p : 0;
+    const Vec<v_count + q> z =
+        normal_vector<v_count + q>(RngKey{11, Stream::filter_noise}, member, ensemble_member, step);
+    Vec<p> zv = Vec<p>::zero();
+    Vec<q> zw;
+    for (int i = 0; i < v_count; ++i) zv[i] = z[i];
+    for (int i = 0; i < q; ++i) zw[i] = z[v_count + i];
     const Vec<p> hx = model.observation(in.t, x[k]);
     const Vec<p> innovation = stochastic ? dy - hx * dt - LV * zv * std::sqrt(dt) : dy - (hx + h_bar) * (0.5 * dt);
     Vec<n> y = x[k] + K * innovation;
