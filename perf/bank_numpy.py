@@ -17,7 +17,8 @@ kernels/filters/filter_bank_step.hpp do it:
     KBL (linearized_kalman_bucy_filter.hpp):   a = -m,                         J = -1            (at the origin)
 Timed, the bank draws from NumPy's default generator. With --philox it draws kushner's own numbers instead
 (Philox4x32-10 keyed by {seed, stream}, counter {member, 0, step, 0}, 52-bit uniforms, Box-Muller: kernels/rng.hpp;
-a truth's dv is the first normal of its step's block of the process-noise stream and dw the second), so it sees the very noise `kushner filter --seed S` sees, and --check DIR (a kushner filter run's summary.json with
+a truth's dv is the first normal of its step's block of the process-noise stream and dw the second), so it sees
+the very noise `kushner filter --seed S` sees, and --check DIR (a kushner filter run's summary.json with
 the same M, T, dt and seed) compares every filter's rmse_truth and nees: they agree to rounding (libm vs NumPy's
 sin/cos/exp/log, and P / S vs kushner's P (1 / S)). --metrics computes kushner's rmse_truth (root of
 the time-and-ensemble mean of (m - x)^2 over the time points 0, dt, ..., T, delta-method standard error) and nees.
