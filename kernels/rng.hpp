@@ -153,18 +153,28 @@ KOKKOS_INLINE_FUNCTION Vec<N> normal_vector(const RngKey& key, std::uint32_t mem
   return z;
 }
 
+/// Where P observation normals v and Q process normals w lie among the `normals` = P + Q normals of one draw
+/// (normal_vector<P + Q>, or a lane's rows of draw_normal_lanes<P + Q>): v first, v_i at v + i and w_i at w + i.
+/// With P = 0, w alone. v first, so that a model whose noise is padded with columns of zeros (a model file's Q is
+/// its state dimension) draws the numbers of the model without them.
+template <int P, int Q>
+struct ObservationAndProcessLayout {
+  static constexpr int normals = P + Q;
+  static constexpr int v = 0;
+  static constexpr int w = P;
+};
+
 /// The P observation normals v and the Q process normals w of one (member, particle, step) as one vector of `key`'s
-/// blocks, v first (normal_vector<P + Q>): where P and Q are both odd, one block and one Box-Muller pair serve the
-/// last of v and the first of w. v first, so that a model whose noise is padded with columns of zeros (a model
-/// file's Q is its state dimension) draws the numbers of the model without them. The truths and the stochastic
-/// EnKBF's ensemble members draw so.
+/// blocks (ObservationAndProcessLayout): where P and Q are both odd, one block and one Box-Muller pair serve the
+/// last of v and the first of w. The truths and the stochastic EnKBF's ensemble members draw so.
 template <int P, int Q>
 KOKKOS_INLINE_FUNCTION void observation_and_process_normals(const RngKey& key, std::uint32_t member,
                                                             std::uint32_t particle, std::uint32_t step, Vec<P>& v,
                                                             Vec<Q>& w) {
-  const Vec<P + Q> z = normal_vector<P + Q>(key, member, particle, step);
-  for (int i = 0; i < P; ++i) v[i] = z[i];
-  for (int i = 0; i < Q; ++i) w[i] = z[P + i];
+  using Layout = ObservationAndProcessLayout<P, Q>;
+  const Vec<Layout::normals> z = normal_vector<Layout::normals>(key, member, particle, step);
+  for (int i = 0; i < P; ++i) v[i] = z[Layout::v + i];
+  for (int i = 0; i < Q; ++i) w[i] = z[Layout::w + i];
 }
 
 /// N uniforms in (0, 1) for one (member, particle, step): blocks draw = 0 .. ceil(N/2)-1.

@@ -126,8 +126,9 @@ struct EulerMaruyamaTruthStep {
     next = xm + model.drift(at, xm, u) * dt + model.diffusion(at, xm) * dw;
   }
 
-  /// Normals per member of a host chunk: observation noise, then process noise (observation_and_process_normals').
-  static constexpr int lane_draws = Model::obs_dim + Model::noise_dim;
+  /// A member's normals on the host: observation_and_process_normals', in their layout.
+  using LaneLayout = ObservationAndProcessLayout<Model::obs_dim, Model::noise_dim>;
+  static constexpr int lane_draws = LaneLayout::normals;
 
   /// Host: the chunk's normals in SIMD lanes (draw_normal_lanes), z[k * host_member_chunk + member - begin] for
   /// normal k of lane_draws.
@@ -161,8 +162,8 @@ struct EulerMaruyamaTruthStep {
     Vec<p> increment, zv;
     Vec<q> zw;
     for (int i = 0; i < n; ++i) xm[i] = xs[member + i * x_stride];
-    for (int k = 0; k < p; ++k) zv[k] = z[k * host_member_chunk];
-    for (int k = 0; k < q; ++k) zw[k] = z[(p + k) * host_member_chunk];
+    for (int k = 0; k < p; ++k) zv[k] = z[(LaneLayout::v + k) * host_member_chunk];
+    for (int k = 0; k < q; ++k) zw[k] = z[(LaneLayout::w + k) * host_member_chunk];
     advance_state(t, Model::Control::zero(), xm, zw, zv, next, increment);
     for (int i = 0; i < p; ++i) dys[member + i * dy_stride] = ok ? increment[i] : dys[member + i * dy_stride];
     for (int i = 0; i < n; ++i) xs[member + i * x_stride] = ok ? next[i] : xm[i];

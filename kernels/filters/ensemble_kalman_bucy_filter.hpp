@@ -183,6 +183,10 @@ struct EnsembleKalmanBucyBase {
     x += model.drift(in.t, x, Model::Control::zero()) * in.dt + model.diffusion(in.t, x) * zw * sqrt_dt;
   }
 
+  /// An ensemble member's normals on the host: the stochastic variant's v and w (observation_and_process_normals'),
+  /// or w alone (normal_vector<q>'s), in their layout.
+  using LaneLayout = ObservationAndProcessLayout<Stochastic ? p : 0, q>;
+
   /// Host: every ensemble member's move, host_member_chunk of them at a time in SIMD lanes: their normals first
   /// (draw_normal_lanes: the same numbers as normal_vector, glibc's vector log, sin and cos), then the moves. The
   /// stochastic EnKBF's scalar draws and drift (libm's log, cos, sin per ensemble member) took 62% of `kushner
@@ -191,7 +195,7 @@ struct EnsembleKalmanBucyBase {
                      const Mat<p, p>& LV, const Vec<p>& h_bar, const double sqrt_dt, const RngKey& noise_key,
                      const std::uint32_t who, const std::uint32_t step_index) const {
     constexpr int chunk = host_member_chunk;
-    constexpr int draws = Stochastic ? p + q : q;  // observation_and_process_normals' (v, then w), or w alone
+    constexpr int draws = LaneLayout::normals;
     const auto counter_of = [who, step_index](const int k, const int draw) {
       return Counter{who, static_cast<std::uint32_t>(k), step_index, static_cast<std::uint32_t>(draw)};
     };
@@ -217,10 +221,9 @@ struct EnsembleKalmanBucyBase {
     Vec<q> zw;
     Vec<p> zv = Vec<p>::zero();
     for (int i = 0; i < n; ++i) xk[i] = x[i * i_stride];
-    constexpr int w_first = Stochastic ? p : 0;  // move_in_lanes' draws: v, then w; or w alone
     if constexpr (Stochastic)
-      for (int j = 0; j < p; ++j) zv[j] = z[j * host_member_chunk];
-    for (int j = 0; j < q; ++j) zw[j] = z[(w_first + j) * host_member_chunk];
+      for (int j = 0; j < p; ++j) zv[j] = z[(LaneLayout::v + j) * host_member_chunk];
+    for (int j = 0; j < q; ++j) zw[j] = z[(LaneLayout::w + j) * host_member_chunk];
     move(model, in, K, LV, h_bar, sqrt_dt, zv, zw, xk);
     for (int i = 0; i < n; ++i) x[i * i_stride] = xk[i];
   }
