@@ -46,50 +46,79 @@ KOKKOS_INLINE_FUNCTION double pairwise_sum(const double* a) {
     return pairwise_sum<N / 2>(a) + pairwise_sum<N - N / 2>(a + N / 2);
 }
 
+namespace detail {
+/// block_statistic's passes, lane by lane: member m adds into lane (m - begin) % moment_lanes, in member order.
+/// `Masked`: a non-finite value adds nothing (its lane's count too); not Masked: every value adds (no count).
+template <bool Masked, class Value>
+KOKKOS_INLINE_FUNCTION void add_block_values(const Value& value, const int begin, const int end, double* count,
+                                             double* sum) {
+  constexpr int L = moment_lanes;
+  const auto add = [&](const int j, const double v) {
+    if constexpr (Masked) {
+      const bool finite = math::is_finite(v);
+      count[j] += finite ? 1.0 : 0.0;
+      sum[j] += finite ? v : 0.0;
+    } else {
+      sum[j] += v;
+    }
+  };
+  int m0 = begin;
+  for (; m0 + L <= end; m0 += L)
+    for (int j = 0; j < L; ++j) add(j, value(m0 + j));
+  for (int j = 0; m0 + j < end; ++j) add(j, value(m0 + j));
+}
+
+/// The lanes' squared deviations from `mean`, pairwise added; `Masked`: a non-finite value adds nothing.
+template <bool Masked, class Value>
+KOKKOS_INLINE_FUNCTION double block_squared_deviations(const Value& value, const int begin, const int end,
+                                                       const double mean) {
+  constexpr int L = moment_lanes;
+  double ss[L];
+  for (int j = 0; j < L; ++j) ss[j] = 0.0;
+  const auto add = [&](const int j, const double v) {
+    const double d = !Masked || math::is_finite(v) ? v - mean : 0.0;
+    ss[j] += d * d;
+  };
+  int m0 = begin;
+  for (; m0 + L <= end; m0 += L)
+    for (int j = 0; j < L; ++j) add(j, value(m0 + j));
+  for (int j = 0; m0 + j < end; ++j) add(j, value(m0 + j));
+  return pairwise_sum<L>(ss);
+}
+}  // namespace detail
+
 /// The BlockStatistic of value(m), m in [begin, end), leaving out non-finite values. Two passes (the sum, then the
 /// squared deviations from the block's mean); in each, member m adds into lane (m - begin) % 32, in member order,
 /// and the lanes are added by pairwise_sum. So no division per member (Welford's recurrence, a chain of dependent
 /// divisions, made these reductions the slowest part of an output step on the host and on the GPU), 32 independent
 /// chains (a loop the host compiler vectorizes, and on a GPU one lane per thread of a warp: team_block_statistic),
 /// and the same bits on every backend and thread count (up to the multiply-adds a GPU contracts).
+/// A block whose values are all finite (every block but those with a diverged member) takes the passes unmasked: a
+/// non-finite value leaves its lane's sum, and so the lanes' total, infinite or NaN for good, so a finite total means
+/// every value was finite, and then the masked passes would add the same values in the same order: the same bits,
+/// with the count end - begin. The unmasked passes took half the time of the masked ones on the host (an output
+/// step's reductions, perf/filter_bank.md); a total that overflowed takes the masked passes too.
 template <class Value>
 KOKKOS_INLINE_FUNCTION BlockStatistic block_statistic(const Value& value, const int begin, const int end) {
   constexpr int L = moment_lanes;
   double count[L], sum[L];
   for (int j = 0; j < L; ++j) count[j] = sum[j] = 0.0;
-  int m0 = begin;
-  for (; m0 + L <= end; m0 += L)
-    for (int j = 0; j < L; ++j) {
-      const double v = value(m0 + j);
-      const bool finite = math::is_finite(v);
-      count[j] += finite ? 1.0 : 0.0;
-      sum[j] += finite ? v : 0.0;
-    }
-  for (int j = 0; m0 + j < end; ++j) {
-    const double v = value(m0 + j);
-    const bool finite = math::is_finite(v);
-    count[j] += finite ? 1.0 : 0.0;
-    sum[j] += finite ? v : 0.0;
-  }
   BlockStatistic s;
+  if (end <= begin) return s;
+  detail::add_block_values<false>(value, begin, end, count, sum);
+  const double total = pairwise_sum<L>(sum);
+  if (math::is_finite(total)) {
+    s.count = static_cast<double>(end - begin);
+    s.mean = total / s.count;
+    s.m2 = detail::block_squared_deviations<false>(value, begin, end, s.mean);
+    return s;
+  }
+  for (int j = 0; j < L; ++j) sum[j] = 0.0;  // a total that overflowed, or a non-finite value: the masked passes
+  detail::add_block_values<true>(value, begin, end, count, sum);
   s.count = pairwise_sum<L>(count);
   if (s.count == 0.0) return s;
   s.mean = pairwise_sum<L>(sum) / s.count;
-  double ss[L];
-  for (int j = 0; j < L; ++j) ss[j] = 0.0;
-  m0 = begin;
-  for (; m0 + L <= end; m0 += L)
-    for (int j = 0; j < L; ++j) {
-      const double v = value(m0 + j);
-      const double d = math::is_finite(v) ? v - s.mean : 0.0;
-      ss[j] += d * d;
-    }
-  for (int j = 0; m0 + j < end; ++j) {
-    const double v = value(m0 + j);
-    const double d = math::is_finite(v) ? v - s.mean : 0.0;
-    ss[j] += d * d;
-  }
-  s.m2 = pairwise_sum<L>(ss);
+  s.m2 = detail::block_squared_deviations<true>(value, begin, end, s.mean);
   return s;
 }
 

@@ -32,8 +32,11 @@
 
 namespace kushner {
 
-/// Members per host work item: small enough that 200 members keep 2 threads busy, large enough for SIMD.
-constexpr int host_member_chunk = 32;
+/// Members per host work item: small enough that 200 members keep 2 threads busy, large enough that a chunk's fixed
+/// cost is small (each of a bank's lane loops sets itself up again per chunk: at 32 members that cost the sine bank
+/// 9% at 1e6 members; perf/filter_bank.md). A multiple of every vector width, so that which members a loop's
+/// vector body takes, and which its remainder, does not depend on it: only on the number of members.
+constexpr int host_member_chunk = 128;
 
 /// The end of the host chunk that starts at `begin`, of members that end at `end`.
 KOKKOS_INLINE_FUNCTION constexpr int host_chunk_end(const int begin, const int end) {

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <vector>
 
@@ -281,6 +282,24 @@ TYPED_TEST(EnsembleMomentsTest, MergedBlockRowsArePooledMoments) {
         EXPECT_NEAR(a.variance[0], b.variance[0], 1e-13 * b.variance[0]) << "output " << o << " column " << c;
       }
     }
+  }
+}
+
+/// block_statistic of a block whose values are all finite (its unmasked passes) is, bit for bit, what its masked
+/// passes give: the same block with a NaN after its last value (in the lane after the last one, where it adds
+/// nothing) takes those. For every length of a block, with a large mean and a -0 among the values.
+TEST(BlockStatistic, AllFiniteBlockGivesTheMaskedPassesBits) {
+  std::vector<double> v(moment_block_size + 1);
+  for (int n = 1; n <= moment_block_size; ++n) {
+    for (int m = 0; m < n; ++m) v[m] = 1e3 + std::sin(0.37 * m + n);
+    v[n / 2] = -0.0;
+    v[n] = std::numeric_limits<double>::quiet_NaN();
+    const auto value = [&](const int m) { return v[m]; };
+    const BlockStatistic unmasked = block_statistic(value, 0, n), masked = block_statistic(value, 0, n + 1);
+    EXPECT_EQ(unmasked.count, n);
+    EXPECT_EQ(masked.count, n);
+    EXPECT_EQ(std::memcmp(&unmasked.mean, &masked.mean, sizeof(double)), 0) << n << " members";
+    EXPECT_EQ(std::memcmp(&unmasked.m2, &masked.m2, sizeof(double)), 0) << n << " members";
   }
 }
 

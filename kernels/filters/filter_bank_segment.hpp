@@ -90,8 +90,7 @@ struct FilterBankSegment {
       // What a step at a time leaves in the snapshot columns (a checkpoint saves them); only then read again.
       for (int c = 0; c < num_columns; ++c)
         if (columns[c].sink >= 0)
-          for (int m = begin; m < end; ++m)
-            store_streaming(columns[c].column + m, sink[columns[c].sink * moment_block_size + m - begin]);
+          store_streaming_run(columns[c].column + begin, sink + columns[c].sink * moment_block_size, end - begin);
       streaming_stores_done();
     }
   }

@@ -184,10 +184,8 @@ struct FilterBankStep {
       // columns, after the step.
       double* const snapshot = slot.snapshot.data();
       const std::size_t snapshot_stride = slot.snapshot.stride(1);
-      for (int member = begin; member < end; ++member) {
-        store_streaming(snapshot + member + snapshot_squared_error * snapshot_stride, error[member - begin]);
-        store_streaming(snapshot + member + snapshot_nees * snapshot_stride, nees[member - begin]);
-      }
+      store_streaming_run(snapshot + begin + snapshot_squared_error * snapshot_stride, error, end - begin);
+      store_streaming_run(snapshot + begin + snapshot_nees * snapshot_stride, nees, end - begin);
     }
   }
 };

@@ -155,7 +155,10 @@ head -c 2000 "$work/good.kushner" > "$work/run/checkpoint.kushner"
 refused_resume "truncated" "$work/run"
 cp "$work/good.kushner" "$work/run/checkpoint.kushner"
 size=$(stat -c %s "$work/run/checkpoint.kushner")
-printf '\x55' | dd of="$work/run/checkpoint.kushner" bs=1 seek=$((size - 100)) conv=notrunc status=none
+# One byte near the end, inverted (writing a fixed byte changed nothing where the byte was that already: a run
+# stopped at step 119 had 0x55 there, and its resume rightly succeeded).
+byte=$(od -An -tu1 -j $((size - 100)) -N 1 "$work/run/checkpoint.kushner" | tr -d ' ')
+printf "\\x$(printf '%02x' $((byte ^ 0xff)))" | dd of="$work/run/checkpoint.kushner" bs=1 seek=$((size - 100)) conv=notrunc status=none
 refused_resume "corrupt (checksum mismatch)" "$work/run"
 sed '2s/"version":"[^"]*"/"version":"kushner 0.0.1 (git 000000000000)"/' "$work/good.kushner" > "$work/run/checkpoint.kushner"
 refused_resume "written by kushner 0.0.1 (git 000000000000); this is kushner" "$work/run"

@@ -122,14 +122,15 @@ TEST(EnsembleKalmanBucyFilter, SameSeedSameNumbersOtherSeedOthers) {
 
 /// One step of ensemble filter Filter (host) for member 1 of 3, against the step written out: the statistics, the
 /// gain, then each ensemble member's update with its own normals (counter {member, ensemble member, step}: process
-/// noise after the perturbation, on Stream::filter_noise), libm's sin and log. 37 ensemble
-/// members: a chunk of 32 lanes and a remainder. Returns the largest difference relative to the value's scale.
+/// noise after the perturbation, on Stream::filter_noise), libm's sin and log. 133 ensemble members: a chunk of 128
+/// lanes and a chunk of 5 (not a multiple of a vector's width). Returns the largest difference relative to the
+/// value's scale.
 template <template <class, class> class Filter, class Model>
 double largest_difference_from_written_out_step(const Model& model) {
   constexpr int n = Model::state_dim, p = Model::obs_dim;
   constexpr bool stochastic =
       std::is_same_v<Filter<Model, Kokkos::HostSpace>, StochasticEnsembleKalmanBucyFilter<Model, Kokkos::HostSpace>>;
-  constexpr int N = 37, member = 1;
+  constexpr int N = 133, member = 1;
   constexpr std::uint32_t step = 5;
   OptionValues options;
   options.set("enkbf_particles", static_cast<long>(N));
