@@ -32,11 +32,10 @@
 
 namespace kushner {
 
-/// Members per host work item: small enough that 200 members keep 2 threads busy, large enough that a chunk's fixed
-/// cost is small (each of a bank's lane loops sets itself up again per chunk: at 32 members that cost the sine bank
-/// 9% at 1e6 members; perf/filter_bank.md). A multiple of every vector width, so that which members a loop's
-/// vector body takes, and which its remainder, does not depend on it: only on the number of members.
-constexpr int host_member_chunk = 128;
+/// Members per host work item: small enough that 200 members keep 2 threads busy, large enough for SIMD. (128 made the
+/// sine bank 9% faster at 1e6 members, a lane loop's set-up per chunk paid less often, but left 300 members 3 work
+/// items, 256 and 44 on 2 threads: `compare` at 300 members 14-21% slower; perf/filter_bank.md.)
+constexpr int host_member_chunk = 32;
 
 /// The end of the host chunk that starts at `begin`, of members that end at `end`.
 KOKKOS_INLINE_FUNCTION constexpr int host_chunk_end(const int begin, const int end) {

@@ -122,7 +122,7 @@ TEST(EnsembleKalmanBucyFilter, SameSeedSameNumbersOtherSeedOthers) {
 
 /// One step of ensemble filter Filter (host) for member 1 of 3, against the step written out: the statistics, the
 /// gain, then each ensemble member's update with its own normals (counter {member, ensemble member, step}: process
-/// noise after the perturbation, on Stream::filter_noise), libm's sin and log. 133 ensemble members: a chunk of 128
+/// noise after the perturbation, on Stream::filter_noise), libm's sin and log. 133 ensemble members: four chunks of 32
 /// lanes and a chunk of 5 (not a multiple of a vector's width). Returns the largest difference relative to the
 /// value's scale.
 template <template <class, class> class Filter, class Model>
