@@ -47,21 +47,11 @@ KOKKOS_INLINE_FUNCTION double pairwise_sum(const double* a) {
 }
 
 namespace detail {
-/// block_statistic's passes, lane by lane: member m adds into lane (m - begin) % moment_lanes, in member order.
-/// `Masked`: a non-finite value adds nothing (its lane's count too); not Masked: every value adds (no count).
-template <bool Masked, class Value>
-KOKKOS_INLINE_FUNCTION void add_block_values(const Value& value, const int begin, const int end, double* count,
-                                             double* sum) {
+/// add(j, value(m)) for m in [begin, end), in member order, j = (m - begin) % moment_lanes: how each of
+/// block_statistic's passes adds a block into its lanes.
+template <class Value, class Add>
+KOKKOS_INLINE_FUNCTION void add_block_lanes(const Value& value, const int begin, const int end, const Add& add) {
   constexpr int L = moment_lanes;
-  const auto add = [&](const int j, const double v) {
-    if constexpr (Masked) {
-      const bool finite = math::is_finite(v);
-      count[j] += finite ? 1.0 : 0.0;
-      sum[j] += finite ? v : 0.0;
-    } else {
-      sum[j] += v;
-    }
-  };
   int m0 = begin;
   for (; m0 + L <= end; m0 += L)
     for (int j = 0; j < L; ++j) add(j, value(m0 + j));
@@ -75,14 +65,10 @@ KOKKOS_INLINE_FUNCTION double block_squared_deviations(const Value& value, const
   constexpr int L = moment_lanes;
   double ss[L];
   for (int j = 0; j < L; ++j) ss[j] = 0.0;
-  const auto add = [&](const int j, const double v) {
+  add_block_lanes(value, begin, end, [&](const int j, const double v) {
     const double d = !Masked || math::is_finite(v) ? v - mean : 0.0;
     ss[j] += d * d;
-  };
-  int m0 = begin;
-  for (; m0 + L <= end; m0 += L)
-    for (int j = 0; j < L; ++j) add(j, value(m0 + j));
-  for (int j = 0; m0 + j < end; ++j) add(j, value(m0 + j));
+  });
   return pairwise_sum<L>(ss);
 }
 }  // namespace detail
@@ -105,7 +91,7 @@ KOKKOS_INLINE_FUNCTION BlockStatistic block_statistic(const Value& value, const 
   for (int j = 0; j < L; ++j) count[j] = sum[j] = 0.0;
   BlockStatistic s;
   if (end <= begin) return s;
-  detail::add_block_values<false>(value, begin, end, count, sum);
+  detail::add_block_lanes(value, begin, end, [&](const int j, const double v) { sum[j] += v; });
   const double total = pairwise_sum<L>(sum);
   if (math::is_finite(total)) {
     s.count = static_cast<double>(end - begin);
@@ -114,7 +100,11 @@ KOKKOS_INLINE_FUNCTION BlockStatistic block_statistic(const Value& value, const 
     return s;
   }
   for (int j = 0; j < L; ++j) sum[j] = 0.0;  // a total that overflowed, or a non-finite value: the masked passes
-  detail::add_block_values<true>(value, begin, end, count, sum);
+  detail::add_block_lanes(value, begin, end, [&](const int j, const double v) {
+    const bool finite = math::is_finite(v);
+    count[j] += finite ? 1.0 : 0.0;
+    sum[j] += finite ? v : 0.0;
+  });
   s.count = pairwise_sum<L>(count);
   if (s.count == 0.0) return s;
   s.mean = pairwise_sum<L>(sum) / s.count;
