@@ -59,6 +59,9 @@ KOKKOS_INLINE_FUNCTION double cos_apart_from_sin(double x) {
 #endif
 }
 
+/// Host: cos(2 pi u) as cos_sin_two_pi computes its c there, the same bits (one expression for both).
+inline double cos_two_pi_host(double u) { return cos(2.0 * pi * u); }
+
 /// c = cos(2 pi u), s = sin(2 pi u). On a GPU CUDA's sincospi: no range reduction and one polynomial pair for
 /// both (the angle 2 pi u is never rounded); elsewhere libm's (or libmvec's) cos and sin of the rounded angle.
 KOKKOS_INLINE_FUNCTION void cos_sin_two_pi(double u, double& c, double& s) {
@@ -67,7 +70,7 @@ KOKKOS_INLINE_FUNCTION void cos_sin_two_pi(double u, double& c, double& s) {
 #else
   // The same angle twice, as (2 pi) u and pi (2 u): equal bits (both products are exact before the one
   // rounding), but two expressions, so GCC does not fuse cos and sin into sincos, which has no vector version.
-  c = cos(2.0 * pi * u);
+  c = cos_two_pi_host(u);
   s = sin(pi * (2.0 * u));
 #endif
 }

@@ -32,10 +32,17 @@
 
 namespace kushner {
 
-/// Members per host work item: small enough that 200 members keep 2 threads busy, large enough for SIMD. (128 made the
-/// sine bank 9% faster at 1e6 members, a lane loop's set-up per chunk paid less often, but left 300 members 3 work
-/// items, 256 and 44 on 2 threads: `compare` at 300 members 14-21% slower; perf/filter_bank.md.)
+/// Members per host work item: small enough that 200 members keep 2 threads busy, large enough for SIMD. (As work
+/// items, 128 left 300 members 3 items, 256 and 44 on 2 threads: `compare` at 300 members 14-21% slower.)
 constexpr int host_member_chunk = 32;
+
+/// The most members one host chunk function takes (its lane arrays hold this many). A host segment's block, whose
+/// thread is already chosen, goes through its steps in runs of this many (run_member_runs): each filter's lane loop
+/// sets itself up once per run (its model, views' pointers, spills), 9% of the sine bank at 1e6 members in runs of
+/// 32 (perf/filter_bank.md). A multiple of every vector width, so it changes no bits: which members a vector body
+/// takes, and which its remainder, depends only on the number of members.
+constexpr int host_lane_capacity = 128;
+static_assert(host_lane_capacity % host_member_chunk == 0, "a work item must fit a chunk function's lanes");
 
 /// The end of the host chunk that starts at `begin`, of members that end at `end`.
 KOKKOS_INLINE_FUNCTION constexpr int host_chunk_end(const int begin, const int end) {
@@ -59,6 +66,13 @@ KUSHNER_SAME_CODE_FOR_ALL_CALLERS void run_member_chunk(const Functor& f, int be
   } else {
     for (int member = begin; member < end; ++member) f(member);
   }
+}
+
+/// run_member_chunk over the members [begin, end) in runs of host_lane_capacity (one thread's block of members).
+template <class Functor>
+void run_member_runs(const Functor& f, const int begin, const int end) {
+  for (int run = begin; run < end; run += host_lane_capacity)
+    run_member_chunk(f, run, end - run < host_lane_capacity ? end : run + host_lane_capacity);
 }
 
 template <class Functor>

@@ -121,6 +121,12 @@ KOKKOS_INLINE_FUNCTION NormalPair box_muller(double u0, double u1) {
   return {radius * c, radius * s};
 }
 
+/// Host: box_muller's z0 alone (the same bits), for a draw that needs one normal of its last block: the sine that
+/// z1 would take is not computed.
+inline double box_muller_cosine_host(double u0, double u1) {
+  return math::sqrt(-2.0 * math::log(u0)) * math::cos_two_pi_host(u1);
+}
+
 /// box_muller in float (the particle filter's `mixed` precision): a GPU's fp32 log, sqrt and sincospi cost a
 /// fraction of their fp64 versions; the normals are returned as doubles for the fp64 state.
 KOKKOS_INLINE_FUNCTION NormalPair box_muller_fp32(float u0, float u1) {

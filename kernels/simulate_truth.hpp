@@ -130,7 +130,7 @@ struct EulerMaruyamaTruthStep {
   using LaneLayout = ObservationAndProcessLayout<Model::obs_dim, Model::noise_dim>;
   static constexpr int lane_draws = LaneLayout::normals;
 
-  /// Host: the chunk's normals in SIMD lanes (draw_normal_lanes), z[k * host_member_chunk + member - begin] for
+  /// Host: the chunk's normals in SIMD lanes (draw_normal_lanes), z[k * host_lane_capacity + member - begin] for
   /// normal k of lane_draws.
   KUSHNER_FLATTEN void draw_lanes(const int begin, const int end, double* const z) const {
     draw_lane_normals<lane_draws>(begin, end, RngKey{seed, Stream::process_noise}, z);
@@ -139,7 +139,7 @@ struct EulerMaruyamaTruthStep {
   /// Host: the members of one chunk in SIMD lanes (kernels/for_each_member.hpp's run_member_chunk): the draws
   /// (draw_lanes), then the step (step_lane).
   KUSHNER_FLATTEN void run_chunk(const int begin, const int end) const {
-    double z[lane_draws * host_member_chunk];
+    double z[lane_draws * host_lane_capacity];
     draw_lanes(begin, end, z);
     double* const xs = x.data();  // raw pointers: GCC does not vectorize a loop that reloads a View's pointer
     double* const dys = dy.data();
@@ -150,7 +150,7 @@ struct EulerMaruyamaTruthStep {
   }
 
   /// One member of run_chunk: x(member) and dy(member) at xs[member + i x_stride], dys[member + i dy_stride], its
-  /// normals at z[k * host_member_chunk] (draw_lanes); `ok` false: computed but not stored (a truth that has left
+  /// normals at z[k * host_lane_capacity] (draw_lanes); `ok` false: computed but not stored (a truth that has left
   /// the run). Returns whether x and dy are finite. The loop body is this one call with scalar arguments: a local
   /// of the body whose address is taken (a Vec, whose operator[] is a call before inlining) becomes an `omp simd`
   /// array, and GCC does not vectorize copies of those.
@@ -162,8 +162,8 @@ struct EulerMaruyamaTruthStep {
     Vec<p> increment, zv;
     Vec<q> zw;
     for (int i = 0; i < n; ++i) xm[i] = xs[member + i * x_stride];
-    for (int k = 0; k < p; ++k) zv[k] = z[(LaneLayout::v + k) * host_member_chunk];
-    for (int k = 0; k < q; ++k) zw[k] = z[(LaneLayout::w + k) * host_member_chunk];
+    for (int k = 0; k < p; ++k) zv[k] = z[(LaneLayout::v + k) * host_lane_capacity];
+    for (int k = 0; k < q; ++k) zw[k] = z[(LaneLayout::w + k) * host_lane_capacity];
     advance_state(t, Model::Control::zero(), xm, zw, zv, next, increment);
     for (int i = 0; i < p; ++i) dys[member + i * dy_stride] = ok ? increment[i] : dys[member + i * dy_stride];
     for (int i = 0; i < n; ++i) xs[member + i * x_stride] = ok ? next[i] : xm[i];
@@ -171,7 +171,7 @@ struct EulerMaruyamaTruthStep {
   }
 
  private:
-  /// N normals per member of the chunk from `key` into z[k * host_member_chunk + member - begin]: normal_vector's
+  /// N normals per member of the chunk from `key` into z[k * host_lane_capacity + member - begin]: normal_vector's
   /// (blocks draw = 0 .. ceil(N/2) - 1 of (member, 0, step)).
   template <int N>
   void draw_lane_normals(const int begin, const int end, const RngKey& key, double* const z) const {
@@ -181,7 +181,7 @@ struct EulerMaruyamaTruthStep {
         [k](const int member, const int draw) {
           return Counter{static_cast<std::uint32_t>(member), 0, k, static_cast<std::uint32_t>(draw)};
         },
-        z, host_member_chunk);
+        z, host_lane_capacity);
   }
 };
 

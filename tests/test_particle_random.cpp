@@ -2,6 +2,7 @@
 // (kernels/rng.hpp, used on the GPU): the same uniforms bit for bit, the same normals to the last bits of the
 // math library; and the particle pairs' draws (kernels/particle_filter/particle_draws.hpp), in fp64 and in the
 // `mixed` precision's fp32.
+#include "kernels/for_each_member.hpp"
 #include "kernels/particle_filter/particle_draws.hpp"
 
 #include <gtest/gtest.h>
@@ -57,6 +58,40 @@ TEST(ParticleDraws, PairFollowsTheDocumentedBlocks) {
   pair_uniforms<SimdDraws>(key, 3, 17, 9, 2, v0, v1);
   EXPECT_EQ(v0, u0);
   EXPECT_EQ(v1, u1);
+}
+
+constexpr int lane_stride = 128;
+
+/// draw_normal_lanes<N> over lanes [0, lanes) into z (normal k at z[k lane_stride]), in a function compiled once for
+/// every lane count, as the chunk functions that draw in production are (kernels/for_each_member.hpp): inlined into a
+/// test body whose lane counts it can see, GCC chose scalar code at some call sites and vector code at others, whose
+/// last bits differ.
+template <int N>
+KUSHNER_SAME_CODE_FOR_ALL_CALLERS void draw_lane_normals_apart(const RngKey& key, const int lanes, double* const z) {
+  const auto counter_of = [](const int lane, const int draw) {
+    return Counter{static_cast<std::uint32_t>(lane), 0, 7, static_cast<std::uint32_t>(draw)};
+  };
+  draw_normal_lanes<N>(0, lanes, key, counter_of, z, lane_stride);
+}
+
+TEST(ParticleDraws, OddCountOfLaneNormalsTakesTheLastBlocksCosineNormalBitForBit) {
+  // draw_normal_lanes with N odd computes its last normal without the block's sine: the same bits as normal N - 1 of
+  // N + 1 normals (both of that block's), for lane counts that fill vector bodies and leave remainders.
+  const RngKey key{20261129, Stream::process_noise};
+  constexpr int stride = lane_stride;
+  for (const int lanes : {1, 3, 8, 13, 16, 32, 45, 100, 128}) {
+    double one[stride], two[2 * stride], three[3 * stride], four[4 * stride];
+    draw_lane_normals_apart<1>(key, lanes, one);
+    draw_lane_normals_apart<2>(key, lanes, two);
+    draw_lane_normals_apart<3>(key, lanes, three);
+    draw_lane_normals_apart<4>(key, lanes, four);
+    for (int lane = 0; lane < lanes; ++lane) {
+      ASSERT_EQ(one[lane], two[lane]) << lanes << " lanes, lane " << lane;
+      for (int k = 0; k < 3; ++k)
+        ASSERT_EQ(three[k * stride + lane], four[k * stride + lane])
+            << lanes << " lanes, normal " << k << ", lane " << lane;
+    }
+  }
 }
 
 TEST(ParticleDraws, PairedNormalsAreUncorrelatedUnitNormals) {

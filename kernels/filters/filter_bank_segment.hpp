@@ -5,7 +5,8 @@
 // (kernels/ensemble_moments.hpp). A step at a time, a step streamed each member's ~420 bytes (truth, and per filter m,
 // P, status, three score sums) from memory and back: sine with EKF, SOF, QLF, KBL ran 2.2e7 member-steps/s per thread
 // at 1e6 members against 3.9e7 at 8192 members, whose columns fit in the caches. A member's step is the step kernel's
-// own chunk function (run_member_chunk: the same machine code, on the same chunks) and a block's statistic is
+// own chunk function (run_member_chunk: the same machine code, in runs of host_lane_capacity members, whose vector
+// bodies and remainders take the members that chunks of host_member_chunk give them) and a block's statistic is
 // block_statistic of the same values in the same order, so the numbers are the same bits as those of steps taken one at
 // a time.
 #include "kernels/ensemble_moments.hpp"
@@ -76,8 +77,7 @@ struct FilterBankSegment {
       step.truth.t = k * dt;  // run_step_kernel's time, bit for bit
       step.truth.step = static_cast<std::uint32_t>(k);
       step.record = output_of[s] >= 0;
-      for (int chunk = begin; chunk < end; chunk += host_member_chunk)
-        run_member_chunk(step, chunk, host_chunk_end(chunk, end));
+      run_member_runs(step, begin, end);
       if (output_of[s] < 0) continue;
       double* const row = rows + (static_cast<std::size_t>(output_of[s]) * num_blocks + b) * width;
       for (int c = 0; c < num_columns; ++c) {
@@ -181,8 +181,7 @@ struct FilterBankTeamSegment {
   KOKKOS_INLINE_FUNCTION void step_block(const Step& step, const int begin, const int end) const {
 #if !KUSHNER_CUDA_DEVICE_PASS
     if constexpr (Kokkos::SpaceAccessibility<Kokkos::HostSpace, MemSpace>::accessible)
-      for (int chunk = begin; chunk < end; chunk += host_member_chunk)
-        run_member_chunk(step, chunk, host_chunk_end(chunk, end));
+      run_member_runs(step, begin, end);
 #endif
   }
 

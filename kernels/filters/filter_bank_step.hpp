@@ -86,7 +86,7 @@ struct FilterBankStep {
     if constexpr (Model::discrete_time || TruthModel::discrete_time) {
       for (int member = begin; member < end; ++member) (*this)(member);
     } else {
-      std::int64_t live[host_member_chunk];  // 64-bit: see advance_lane
+      std::int64_t live[host_lane_capacity];  // 64-bit: see advance_lane
       truth_lanes(begin, end, live);
       const Mat<Model::obs_dim, Model::obs_dim> R = model.observation_noise(truth.t);
       (filter_chunk(static_cast<const FilterSlot<Filters, MemSpace>&>(slots), begin, end, live, R * transpose(R)), ...);
@@ -99,7 +99,7 @@ struct FilterBankStep {
   /// The truths of the chunk in SIMD lanes, as operator() steps them (a truth not ok is left as it is, one that
   /// becomes non-finite is marked); live[member - begin]: the member's truth is ok after the step.
   KUSHNER_FLATTEN void truth_lanes(const int begin, const int end, std::int64_t* live) const {
-    double z[TruthStep<TruthModel, MemSpace>::lane_draws * host_member_chunk];
+    double z[TruthStep<TruthModel, MemSpace>::lane_draws * host_lane_capacity];
     truth.draw_lanes(begin, end, z);
     double* const xs = truth.x.data();  // raw pointers: GCC does not vectorize a loop that reloads a View's pointer
     double* const dys = truth.dy.data();
@@ -160,13 +160,13 @@ struct FilterBankStep {
     const double* const dys = truth.dy.data();
     const std::size_t x_stride = truth.x.stride(1), dy_stride = truth.dy.stride(1);
     const double t = truth.t, dt = truth.dt;
-    std::int64_t status[host_member_chunk];  // 64-bit: see advance_lane
+    std::int64_t status[host_lane_capacity];  // 64-bit: see advance_lane
     // The lanes' snapshot values: straight into the block's sink where there is one (an output step of a segment),
     // else into `chunk`, from where an output step stores them in the snapshot columns.
-    double chunk[2 * host_member_chunk];
+    double chunk[2 * host_lane_capacity];
     const bool to_sink = Record && snapshot_sink != nullptr;
     double* const error = to_sink ? snapshot_sink + 2 * slot_index<Filter>() * sink_stride + begin - sink_first : chunk;
-    double* const nees = to_sink ? error + sink_stride : chunk + host_member_chunk;
+    double* const nees = to_sink ? error + sink_stride : chunk + host_lane_capacity;
     for (int member = begin; member < end; ++member)
       status[member - begin] = static_cast<std::int64_t>(slot.status(member));
     KUSHNER_SIMD

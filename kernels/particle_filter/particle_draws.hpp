@@ -43,21 +43,35 @@ KOKKOS_INLINE_FUNCTION NormalPair simd_normal_pair(const RngKey key, const Count
   return box_muller(u0, u1);
 }
 
+/// Host: simd_normal_pair's z0 alone, the same bits, without the sine (box_muller_cosine_host). The counter by value,
+/// as there: GCC does not vectorize a loop that stores it to pass a reference.
+inline double simd_normal_cosine(const RngKey key, const Counter c) {
+  double u0, u1;
+  SimdDraws::uniforms(key, c, u0, u1);
+  return box_muller_cosine_host(u0, u1);
+}
+
 /// Host: N normals for each lane of a SIMD loop over [begin, end), normal i of lane l at z[i * stride + l - begin]
 /// from block i / 2 of counter_of(l, i / 2) (so normal_vector's numbers where counter_of gives its counters), with
 /// glibc's vector log, sqrt, sin and cos. A loop of its own, with no model code in it, so that it vectorizes
 /// whatever the caller's step does: the draws are the same bits for every model, whether or not its step vectorizes
-/// (a model file's polynomial and the built-in model it equals give the same numbers).
+/// (a model file's polynomial and the built-in model it equals give the same numbers). With N odd the last block's
+/// second normal is not wanted, and its sine is not computed (the cubic oscillator's truth step x1.1).
 template <int N, class CounterOf>
 KUSHNER_FLATTEN void draw_normal_lanes(const int begin, const int end, const RngKey& key, const CounterOf& counter_of,
                                        double* const z, const int stride) {
-  for (int i = 0; i < N; i += 2) {
+  for (int i = 0; i + 1 < N; i += 2) {
     KUSHNER_SIMD
     for (int lane = begin; lane < end; ++lane) {
       const NormalPair pair = simd_normal_pair(key, counter_of(lane, i / 2));
       z[i * stride + lane - begin] = pair.z0;
-      if (i + 1 < N) z[(i + 1) * stride + lane - begin] = pair.z1;
+      z[(i + 1) * stride + lane - begin] = pair.z1;
     }
+  }
+  if constexpr (N % 2 == 1) {
+    KUSHNER_SIMD
+    for (int lane = begin; lane < end; ++lane)
+      z[(N - 1) * stride + lane - begin] = simd_normal_cosine(key, counter_of(lane, N / 2));
   }
 }
 
