@@ -242,8 +242,7 @@ class ParticleFilterBank {
     d.initial_mean = Vec<Model::state_dim>::zero();
     d.initial_root = Mat<Model::state_dim, Model::state_dim>::zero();
     d.t = t;
-    d.dt = dt;
-    d.sqrt_dt = std::sqrt(dt);
+    d.set_step_length(dt);
     d.seed = seed_;
     d.step = step;
     d.num_particles = num_particles_;

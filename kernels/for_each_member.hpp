@@ -44,9 +44,10 @@ constexpr int host_member_chunk = 32;
 constexpr int host_lane_capacity = 128;
 static_assert(host_lane_capacity % host_member_chunk == 0, "a work item must fit a chunk function's lanes");
 
-/// The end of the host chunk that starts at `begin`, of members that end at `end`.
-KOKKOS_INLINE_FUNCTION constexpr int host_chunk_end(const int begin, const int end) {
-  return end - begin < host_member_chunk ? end : begin + host_member_chunk;
+/// The end of the host chunk of at most `size` members that starts at `begin`, of members that end at `end`.
+KOKKOS_INLINE_FUNCTION constexpr int host_chunk_end(const int begin, const int end,
+                                                    const int size = host_member_chunk) {
+  return end - begin < size ? end : begin + size;
 }
 
 namespace detail {
@@ -72,7 +73,7 @@ KUSHNER_SAME_CODE_FOR_ALL_CALLERS void run_member_chunk(const Functor& f, int be
 template <class Functor>
 void run_member_runs(const Functor& f, const int begin, const int end) {
   for (int run = begin; run < end; run += host_lane_capacity)
-    run_member_chunk(f, run, end - run < host_lane_capacity ? end : run + host_lane_capacity);
+    run_member_chunk(f, run, host_chunk_end(run, end, host_lane_capacity));
 }
 
 template <class Functor>

@@ -112,10 +112,13 @@ struct NormalPair {
   double z0, z1;
 };
 
+/// Box-Muller's radius sqrt(-2 ln u0), which both of a pair's normals (and a lone cosine normal) take.
+KOKKOS_INLINE_FUNCTION double box_muller_radius(double u0) { return math::sqrt(-2.0 * math::log(u0)); }
+
 /// Box-Muller: two independent standard normals sqrt(-2 ln u0) (cos 2 pi u1, sin 2 pi u1) from two uniforms.
 /// Returned by value: GCC does not vectorize the host particle kernel when they are written through references.
 KOKKOS_INLINE_FUNCTION NormalPair box_muller(double u0, double u1) {
-  const double radius = math::sqrt(-2.0 * math::log(u0));
+  const double radius = box_muller_radius(u0);
   double c, s;
   math::cos_sin_two_pi(u1, c, s);
   return {radius * c, radius * s};
@@ -123,9 +126,7 @@ KOKKOS_INLINE_FUNCTION NormalPair box_muller(double u0, double u1) {
 
 /// Host: box_muller's z0 alone (the same bits), for a draw that needs one normal of its last block: the sine that
 /// z1 would take is not computed.
-inline double box_muller_cosine_host(double u0, double u1) {
-  return math::sqrt(-2.0 * math::log(u0)) * math::cos_two_pi_host(u1);
-}
+inline double box_muller_cosine_host(double u0, double u1) { return box_muller_radius(u0) * math::cos_two_pi_host(u1); }
 
 /// box_muller in float (the particle filter's `mixed` precision): a GPU's fp32 log, sqrt and sincospi cost a
 /// fraction of their fp64 versions; the normals are returned as doubles for the fp64 state.

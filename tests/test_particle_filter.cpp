@@ -414,8 +414,7 @@ template <class Model, class Real>
 double step_one_particle(const Model& model, const Vec<Model::noise_dim>& z, Vec<Model::state_dim>& x) {
   ParticleStepData<Model, Kokkos::HostSpace, Real> d;
   d.model = model;
-  d.dt = 0.01;
-  d.sqrt_dt = std::sqrt(d.dt);
+  d.set_step_length(0.01);
   Mat<Model::obs_dim, Model::obs_dim> precision = Mat<Model::obs_dim, Model::obs_dim>::diagonal(4.0);
   const Vec<Model::obs_dim> vinv_dy = Vec<Model::obs_dim>::constant(0.013);
   return update_particle<false>(d, 0.0, precision, z, 0.0, -7.25, 0.125, vinv_dy, Model::Control::zero(), x);

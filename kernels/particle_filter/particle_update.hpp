@@ -21,6 +21,7 @@
 
 #include <Kokkos_Core.hpp>
 
+#include <cmath>
 #include <cstdint>
 #include <type_traits>
 
@@ -46,6 +47,9 @@ struct ParticleStepData {
   Mat<n, n> initial_root;  // any square root of the initial covariance
   double t = 0.0, dt = 0.0;
   double sqrt_dt = 0.0;  // computed once: nvcc re-evaluated sqrt(dt) for every particle
+  // dt, sqrt(dt) and dt / 2 rounded once for a step computed in float (fp32): converted in the kernel, they took a
+  // conversion each for every particle (nvcc rematerializes them from the constant bank rather than hold registers).
+  float dt_float = 0.0f, sqrt_dt_float = 0.0f, half_dt_float = 0.0f;
   Seed seed;
   std::uint32_t step = 0;
   int num_particles = 0, block_size = 0;
@@ -55,6 +59,38 @@ struct ParticleStepData {
   /// Whether the normals are drawn in float: always where particles are stored in float, which the compiler then
   /// knows (fp32's kernels carry no fp64 Box-Muller), else as fp32_normals says.
   KOKKOS_INLINE_FUNCTION bool float_normals() const { return std::is_same_v<Real, float> || fp32_normals; }
+
+  /// Sets the step's length dt and what the kernels take from it.
+  void set_step_length(const double step_length) {
+    dt = step_length;
+    sqrt_dt = std::sqrt(step_length);
+    dt_float = static_cast<float>(dt);
+    sqrt_dt_float = static_cast<float>(sqrt_dt);
+    half_dt_float = static_cast<float>(0.5 * dt);
+  }
+
+  /// dt, sqrt(dt) and dt / 2 in the scalar S a particle's step is computed in: each is the double rounded to S.
+  template <class S>
+  KOKKOS_INLINE_FUNCTION S dt_as() const {
+    return in_scalar<S>(dt, dt_float);
+  }
+  template <class S>
+  KOKKOS_INLINE_FUNCTION S sqrt_dt_as() const {
+    return in_scalar<S>(sqrt_dt, sqrt_dt_float);
+  }
+  template <class S>
+  KOKKOS_INLINE_FUNCTION S half_dt_as() const {
+    return in_scalar<S>(0.5 * dt, half_dt_float);
+  }
+
+ private:
+  template <class S>
+  KOKKOS_INLINE_FUNCTION static S in_scalar(double as_double, float as_float) {
+    if constexpr (std::is_same_v<S, float>)
+      return as_float;
+    else
+      return as_double;
+  }
 };
 
 /// The second step of a fused pair (particle_team_pair_step.hpp): step + 1, over [t, t + dt]. The pair reads the
@@ -170,11 +206,11 @@ KOKKOS_INLINE_FUNCTION double update_particle_unrounded(
     if constexpr (has_exact_transition<Model>::value) {
       xs = d.model.sample_exact_transition(t, xs, d.dt, z, u);
     } else {
-      xs = xs + d.model.drift(t, xs, control) * static_cast<S>(d.dt) +
-           d.model.diffusion(t, xs) * (convert<S>(z) * static_cast<S>(d.sqrt_dt));
+      xs = xs + d.model.drift(t, xs, control) * d.template dt_as<S>() +
+           d.model.diffusion(t, xs) * (convert<S>(z) * d.template sqrt_dt_as<S>());
     }
     const Vec<p, S> h = d.model.observation(t + d.dt, xs);
-    const S increment = dot(h, convert<S>(vinv_dy)) - static_cast<S>(0.5 * d.dt) * dot(h, convert<S>(precision) * h);
+    const S increment = dot(h, convert<S>(vinv_dy)) - d.template half_dt_as<S>() * dot(h, convert<S>(precision) * h);
     const double l = static_cast<S>(log_weight - log_normalizer) + increment;
     x = convert<double>(xs);
     bool finite = math::is_finite(l);
