@@ -92,8 +92,8 @@ KUSHNER_SAME_CODE_FOR_ALL_CALLERS void particle_block_host(const ParticleStepDat
     KUSHNER_UNROLL_FULLY
     for (int i = 0; i < K; ++i) zj[i] = z[i][j];
     const double uj = draws_uniform<Model, Initialize> ? u[j] : 0.0;
-    const double lj = detail::update_particle_unrounded<Initialize>(d, d.t, d.observation_precision, zj, uj, lw[j],
-                                                                    log_normalizer, vinv_dy, control, xj);
+    const double lj = detail::update_particle_unrounded<Initialize>(d, d.t, d.observation_precision.value, zj, uj,
+                                                                    lw[j], log_normalizer, vinv_dy, control, xj);
     KUSHNER_UNROLL_FULLY
     for (int i = 0; i < n; ++i) xs[i][j] = xj[i];
     lw[j] = lj;

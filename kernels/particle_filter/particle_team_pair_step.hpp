@@ -38,7 +38,7 @@ struct ParticleTeamPairStep {
       KUSHNER_DEVICE_UNROLL
       for (int s = 0; s < 2; ++s) {
         const Vec<p> dy = load<p>(s == 0 ? d.dy : next.dy, member);
-        vinv_dy[s] = precision(s) * dy;
+        vinv_dy[s] = precision<double>(s) * dy;
         bound += log_weight_bound(d.model, dy, vinv_dy[s], d.dt);
         shift[s] = bound;
       }
@@ -57,10 +57,13 @@ struct ParticleTeamPairStep {
   }
 
  private:
+  using S = particle_step_scalar<Model, Real>;  // V^-1 and V^-1 dy are rounded to it once, not for every particle
+
   /// Step s of the pass: its start time and V^{-1} there.
   KOKKOS_INLINE_FUNCTION double step_time(int s) const { return s == 0 ? d.t : next.t; }
-  KOKKOS_INLINE_FUNCTION const Mat<p, p>& precision(int s) const {
-    return s == 0 ? d.observation_precision : next.observation_precision;
+  template <class T>
+  KOKKOS_INLINE_FUNCTION const Mat<p, p, T>& precision(int s) const {
+    return (s == 0 ? d.observation_precision : next.observation_precision).template as<T>();
   }
 
   /// As ParticleTeamStep::step_particles, for both steps: a batch is loaded once, stepped twice, stored once.
@@ -76,6 +79,7 @@ struct ParticleTeamPairStep {
     Real* const lwo = &next.log_weight(0, member);
     const std::size_t stride = d.x.stride_2();  // the same for next.x
     const RngKey key = particle_draw_key<false>(d);
+    const Vec<p, S> vinv_dy_s[2] = {convert<S>(vinv_dy[0]), convert<S>(vinv_dy[1])};
     for (int base = c.begin / 2 + c.rank; base < (c.end + 1) / 2; base += device_pairs_per_batch * c.threads) {
       Vec<n> x[B];
       double lw[B];
@@ -89,8 +93,8 @@ struct ParticleTeamPairStep {
         for (int k = 0; k < B; ++k) {
           const int j = batch_particle(base, k, c.threads);
           if (j >= c.end) continue;
-          const double l = update_particle<false>(d, step_time(s), precision(s), z[k], u[k], lw[k],
-                                                  s == 0 ? log_normalizer : 0.0, vinv_dy[s], uncontrolled(), x[k]);
+          const double l = update_particle<false>(d, step_time(s), precision<S>(s), z[k], u[k], lw[k],
+                                                  s == 0 ? log_normalizer : 0.0, vinv_dy_s[s], uncontrolled(), x[k]);
           if (s == 1) {
             KUSHNER_DEVICE_UNROLL
             for (int i = 0; i < n; ++i) xo[j + i * stride] = static_cast<Real>(x[k][i]);
@@ -112,6 +116,7 @@ struct ParticleTeamPairStep {
     constexpr int K = particle_draw_dim<Model, false>;
     const double log_normalizer = d.log_normalizer(member);
     const RngKey key = particle_draw_key<false>(d);
+    const Vec<p, S> vinv_dy_s = convert<S>(vinv_dy);
     for (int pair = c.begin / 2 + c.rank; pair < (c.end + 1) / 2; pair += c.threads) {
       Vec<K> z[2];
       double u[2];
@@ -120,8 +125,8 @@ struct ParticleTeamPairStep {
         const int j = 2 * pair + k;
         if (j >= c.end) continue;
         Vec<n> x = load_particle<n>(d.x, j, member);
-        const double l = update_particle<false>(d, d.t, d.observation_precision, z[k], u[k], d.log_weight(j, member),
-                                                log_normalizer, vinv_dy, uncontrolled(), x);
+        const double l = update_particle<false>(d, d.t, precision<S>(0), z[k], u[k], d.log_weight(j, member),
+                                                log_normalizer, vinv_dy_s, uncontrolled(), x);
         add_shifted_particle<Real>(l - shift, x - ref, w);
       }
     }

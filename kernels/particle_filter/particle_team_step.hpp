@@ -30,7 +30,7 @@ struct ParticleTeamStep {
         step_particles<true>(member, c, ref, Vec<p>::zero(), shift, w);
       } else {
         const Vec<p> dy = load<p>(d.dy, member);
-        const Vec<p> vinv_dy = d.observation_precision * dy;
+        const Vec<p> vinv_dy = d.observation_precision.value * dy;
         shift = log_weight_bound(d.model, dy, vinv_dy, d.dt);
         step_particles<false>(member, c, ref, vinv_dy, shift, w);
       }
@@ -59,6 +59,9 @@ struct ParticleTeamStep {
     const RngKey key = particle_draw_key<Initialize>(d);
     const std::uint32_t step = particle_draw_step<Initialize>(d);
     const typename Model::Control control = particle_control(d, member);
+    using S = particle_step_scalar<Model, Real>;  // V^-1 and V^-1 dy rounded to it once, not for every particle
+    const Mat<p, p, S>& precision = d.observation_precision.template as<S>();
+    const Vec<p, S> vinv_dy_s = convert<S>(vinv_dy);
     for (int base = c.begin / 2 + c.rank; base < (c.end + 1) / 2; base += device_pairs_per_batch * c.threads) {
       Vec<n> x[B];
       double lw[B];
@@ -70,8 +73,8 @@ struct ParticleTeamStep {
       for (int k = 0; k < B; ++k) {
         const int j = batch_particle(base, k, c.threads);
         if (j >= c.end) continue;
-        const double l = update_particle<Initialize>(d, d.t, d.observation_precision, z[k], u[k], lw[k], log_normalizer,
-                                                     vinv_dy, control, x[k]);
+        const double l =
+            update_particle<Initialize>(d, d.t, precision, z[k], u[k], lw[k], log_normalizer, vinv_dy_s, control, x[k]);
         KUSHNER_DEVICE_UNROLL
         for (int i = 0; i < n; ++i) xm[j + i * stride] = static_cast<Real>(x[k][i]);
         lwm[j] = static_cast<Real>(l);

@@ -27,6 +27,27 @@
 
 namespace kushner {
 
+/// V^{-1} at a step's time, and its entries rounded once to float for a step computed in float (fp32): converted in
+/// the kernel, they took a conversion each for every particle, as dt did (ParticleStepData::set_step_length).
+template <int P>
+struct ObservationPrecision {
+  Mat<P, P> value;
+  Mat<P, P, float> value_float;
+
+  ObservationPrecision() = default;
+  ObservationPrecision(const Mat<P, P>& precision)  // NOLINT(google-explicit-constructor): assigned as a Mat
+      : value(precision), value_float(convert<float>(precision)) {}
+
+  /// V^{-1} in the scalar S a particle's step is computed in.
+  template <class S>
+  KOKKOS_INLINE_FUNCTION const Mat<P, P, S>& as() const {
+    if constexpr (std::is_same_v<S, float>)
+      return value_float;
+    else
+      return value;
+  }
+};
+
 /// Everything one step reads and writes. Views are (particle, member[, i]) or (member[, i]), LayoutLeft. The
 /// particles and log-weights are stored as Real (float in the fp32 precision: particle_precision.hpp); a particle's
 /// step computes in particle_step_scalar<Model, Real>.
@@ -42,7 +63,7 @@ struct ParticleStepData {
   BankScalar<Status, MemSpace> status;
   BankVector<MemSpace> control;  // (member, j): the control over this step (closed loop); empty: none
   Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace> partials;  // (block, member, k)
-  Mat<p, p> observation_precision;                                 // (R R^T)^{-1} at t
+  ObservationPrecision<p> observation_precision;                   // (R R^T)^{-1} at t
   Vec<n> initial_mean;
   Mat<n, n> initial_root;  // any square root of the initial covariance
   double t = 0.0, dt = 0.0;
@@ -103,7 +124,7 @@ struct ParticleSecondStep {
   ParticleColumn<MemSpace, Real> log_weight;
   BankVector<MemSpace> dy;
   Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace> partials;
-  Mat<p, p> observation_precision;
+  ObservationPrecision<p> observation_precision;
   double t = 0.0;
 };
 
@@ -147,7 +168,7 @@ KOKKOS_INLINE_FUNCTION void draw_particle_pair(const RngKey& key, int member, in
 template <class Model, class MemSpace, class Real>
 KOKKOS_INLINE_FUNCTION Vec<Model::obs_dim> precision_times_dy(const ParticleStepData<Model, MemSpace, Real>& d,
                                                               int member) {
-  return d.observation_precision * load<Model::obs_dim>(d.dy, member);
+  return d.observation_precision.value * load<Model::obs_dim>(d.dy, member);
 }
 
 /// The control a member's particles are driven by over this step (zero outside a closed loop).
@@ -181,11 +202,11 @@ KOKKOS_INLINE_FUNCTION double round_to_storage(Vec<N>& x, double l) {
 
 namespace detail {
 /// update_particle before its results are rounded to the bank's storage.
-template <bool Initialize, class Model, class MemSpace, class Real>
+template <bool Initialize, class Model, class MemSpace, class Real, class P>
 KOKKOS_INLINE_FUNCTION double update_particle_unrounded(
-    const ParticleStepData<Model, MemSpace, Real>& d, double t, const Mat<Model::obs_dim, Model::obs_dim>& precision,
+    const ParticleStepData<Model, MemSpace, Real>& d, double t, const Mat<Model::obs_dim, Model::obs_dim, P>& precision,
     const Vec<particle_draw_dim<Model, Initialize>>& z, double u, double log_weight, double log_normalizer,
-    const Vec<Model::obs_dim>& vinv_dy, const typename Model::Control& control, Vec<Model::state_dim>& x) {
+    const Vec<Model::obs_dim, P>& vinv_dy, const typename Model::Control& control, Vec<Model::state_dim>& x) {
   constexpr int n = Model::state_dim, p = Model::obs_dim;
   if constexpr (Initialize) {
     x = d.initial_mean + d.initial_root * z;
@@ -202,6 +223,7 @@ KOKKOS_INLINE_FUNCTION double update_particle_unrounded(
     // In S: float where fp32 stores floats and the model's dynamics take float (particle_step_scalar), else double
     // (every convert<double> below is then a copy, and the expressions are those of the double step).
     using S = particle_step_scalar<Model, Real>;
+    static_assert(std::is_same_v<P, double> || std::is_same_v<P, S>, "V^-1 in double or in the step's scalar");
     Vec<n, S> xs = convert<S>(x);
     if constexpr (has_exact_transition<Model>::value) {
       xs = d.model.sample_exact_transition(t, xs, d.dt, z, u);
@@ -225,13 +247,15 @@ KOKKOS_INLINE_FUNCTION double update_particle_unrounded(
 /// log-weight, normalized by the member's previous log-normalizer; -inf for a particle that left the finite
 /// numbers. `precision` is V^{-1} at t; `control` is the member's (particle_control). A discrete-time model's
 /// precision is the identity, so `vinv_dy` is z[k+1] itself. The step computes in particle_step_scalar (float only
-/// for fp32 and a model with float dynamics); x and the log-weight come out as the bank stores them (stored_value).
-template <bool Initialize, class Model, class MemSpace, class Real>
+/// for fp32 and a model with float dynamics): `precision` and `vinv_dy` in double, or already rounded to that
+/// scalar (the GPU's kernels, once per member, not per particle); x and the log-weight come out as the bank stores
+/// them (stored_value).
+template <bool Initialize, class Model, class MemSpace, class Real, class P>
 KOKKOS_INLINE_FUNCTION double update_particle(const ParticleStepData<Model, MemSpace, Real>& d, double t,
-                                              const Mat<Model::obs_dim, Model::obs_dim>& precision,
+                                              const Mat<Model::obs_dim, Model::obs_dim, P>& precision,
                                               const Vec<particle_draw_dim<Model, Initialize>>& z, double u,
                                               double log_weight, double log_normalizer,
-                                              const Vec<Model::obs_dim>& vinv_dy,
+                                              const Vec<Model::obs_dim, P>& vinv_dy,
                                               const typename Model::Control& control, Vec<Model::state_dim>& x) {
   const double l = detail::update_particle_unrounded<Initialize>(d, t, precision, z, u, log_weight, log_normalizer,
                                                                  vinv_dy, control, x);
