@@ -103,7 +103,7 @@ bundle() {
 
 configure_and_build() {
   if [ ! -f "$build_dir/CMakeCache.txt" ]; then
-    say "configuring $build_dir (Release, OpenMP + Serial)"
+    say "configuring $build_dir (Release, OpenMP)"
     cmake -S "$here" -B "$build_dir" -DCMAKE_BUILD_TYPE=Release "$@" >/dev/null
   fi
   say "building with $jobs jobs"

@@ -265,7 +265,7 @@ nlohmann::json run_controlled_model(const Model& model, const ControlOptions& op
 
   const OutputDirectory out(options.run.out, "--out");
   std::optional<KokkosSession> kokkos;
-  if (own_kokkos) kokkos.emplace();
+  if (own_kokkos) kokkos.emplace(context.backend);
   nlohmann::json summary;
   with_backend(context.backend, [&](const auto& space) {
     Progress progress("control", control_progress_steps<Model>(specs, grid), !options.run.quiet);

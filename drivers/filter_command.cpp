@@ -68,7 +68,7 @@ int run_estimation(const CompareOptions& given, const RunContext& context, const
     const TimeGrid grid = make_time_grid(options.run.T, options.run.dt, options.run.output_points);
     check_compare_options<Model>(model, options, settings);  // before anything is written
     const OutputDirectory out(options.run.out, "--out");
-    KokkosSession kokkos;
+    KokkosSession kokkos(context.backend);
     const nlohmann::json summary = run_compare_command(model, options, settings, grid, context, out, resume);
     if (options.plots && !options.run.quiet) print_summary(summary, options.run.out);
   });

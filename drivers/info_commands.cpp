@@ -89,7 +89,7 @@ int run_filters_list(bool json) {
 
 int run_version() {
   const std::string backend = selected_backend();
-  KokkosSession kokkos;
+  KokkosSession kokkos(backend);
   const BackendDescription b = describe_backend(backend);
   std::cout << version_string() << "\nKokkos " << b.kokkos << "\nbackend: " << backend;
   if (b.threads > 0) std::cout << " (" << b.threads << " threads)";

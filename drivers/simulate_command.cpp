@@ -33,7 +33,7 @@ int run_simulate(const RunOptions& given, const RunContext& context) {
     const RunOptions options = options_for_model_time(given, Model::discrete_time);
     const TimeGrid grid = make_time_grid(options.T, options.dt, options.output_points);
     const OutputDirectory out(options.out, "--out");
-    KokkosSession kokkos;
+    KokkosSession kokkos(context.backend);
     with_backend(context.backend, [&](const auto& space) {
       Progress progress("simulate", grid.steps, !options.quiet);
       const MomentSeries series =

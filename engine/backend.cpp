@@ -46,7 +46,7 @@ std::vector<std::string> available_backends() {
 #if defined(KOKKOS_ENABLE_OPENMP)
   names.emplace_back("openmp");
 #endif
-#if defined(KUSHNER_RUNS_SERIAL)
+#if defined(KUSHNER_SERIAL_ON_OPENMP) || defined(KUSHNER_RUNS_SERIAL)
   names.emplace_back("serial");
 #endif
   return names;
@@ -74,9 +74,10 @@ BackendDescription describe_backend(const std::string& name) {
   if (name == "cuda") d.device = Kokkos::Cuda().cuda_device_prop().name;
 #endif
 #if defined(KOKKOS_ENABLE_OPENMP)
-  if (name == "openmp") d.threads = Kokkos::OpenMP().concurrency();
-#endif
+  if (name == "openmp" || name == "serial") d.threads = Kokkos::OpenMP().concurrency();  // serial: KokkosSession's 1
+#else
   if (name == "serial") d.threads = 1;
+#endif
   return d;
 }
 
@@ -119,9 +120,16 @@ int ranks_sharing_memory(const std::string& name) {
   return (local_ranks() + devices - 1) / devices;
 }
 
-KokkosSession::KokkosSession() {
+KokkosSession::KokkosSession(const std::string& backend) {
   setenv("OMP_PROC_BIND", "false", /*overwrite=*/0);
   std::vector<std::string> args = {"kushner"};
+#if defined(KUSHNER_SERIAL_ON_OPENMP)
+  const bool one_thread = backend == "serial";
+  if (one_thread) args.push_back("--kokkos-threads=1");
+#else
+  (void)backend;
+  const bool one_thread = false;
+#endif
   if (local_ranks() > 1) {
     // Ranks on one node share it: each takes the GPU of its local rank (round robin when there are fewer GPUs,
     // e.g. two ranks on one GPU), and, when mpirun left it unbound and OMP_NUM_THREADS is unset, its share of
@@ -136,7 +144,7 @@ KokkosSession::KokkosSession() {
     const bool unbound =
         sched_getaffinity(0, sizeof mask, &mask) == 0 && CPU_COUNT(&mask) >= static_cast<int>(hardware);
     // OpenMP read OMP_NUM_THREADS when it was loaded: set its thread count itself.
-    if (unbound && std::getenv("OMP_NUM_THREADS") == nullptr)
+    if (unbound && std::getenv("OMP_NUM_THREADS") == nullptr && !one_thread)
       set_openmp_threads(std::max(1u, hardware / local_ranks()));
   }
   std::vector<char*> argv;

@@ -11,10 +11,16 @@
 #include <type_traits>
 #include <vector>
 
-// The serial backend, where Kokkos has it; not in CI's CUDA compile check (KUSHNER_CUDA_COMPILE_CHECK), which
-// compiles the commands for the GPU alone: the host backends' code is the host build's, and leaving it out there
-// saved a quarter of each unit's compile (instance_unit_0: 58.9 -> 45.1 s).
-#if defined(KOKKOS_ENABLE_SERIAL) && !defined(KUSHNER_CUDA_COMPILE_CHECK)
+// The backend `serial` is the host on one thread. Where OpenMP is built it is OpenMP's code on one thread
+// (KokkosSession starts OpenMP with one thread): the same bits as Kokkos::Serial (the reproducibility tests compared
+// the two for every command), and every kernel is compiled once per host instead of twice (instance_unit_0 compiled
+// side by side with and without Kokkos::Serial's copy: 155 -> 127 s, its object 7.4 -> 5.4 MB). The price is OpenMP's
+// parallel region around each kernel on one thread: a one-member run of 80000 steps, 16.0 -> 18.0 s (medians of 5)
+// (`reproduce basin-car-filter`). Kokkos::Serial runs it only in a build without OpenMP (KUSHNER_RUNS_SERIAL), and not
+// in CI's CUDA compile check (KUSHNER_CUDA_COMPILE_CHECK), which compiles the commands for the GPU alone.
+#if defined(KOKKOS_ENABLE_OPENMP)
+#define KUSHNER_SERIAL_ON_OPENMP
+#elif defined(KOKKOS_ENABLE_SERIAL) && !defined(KUSHNER_CUDA_COMPILE_CHECK)
 #define KUSHNER_RUNS_SERIAL
 #endif
 
@@ -48,7 +54,7 @@ void with_backend_type(const std::string& name, F&& f) {
   if (name == "cuda") return f(static_cast<Kokkos::Cuda*>(nullptr));
 #endif
 #if defined(KOKKOS_ENABLE_OPENMP)
-  if (name == "openmp") return f(static_cast<Kokkos::OpenMP*>(nullptr));
+  if (name == "openmp" || name == "serial") return f(static_cast<Kokkos::OpenMP*>(nullptr));
 #endif
 #if defined(KUSHNER_RUNS_SERIAL)
   if (name == "serial") return f(static_cast<Kokkos::Serial*>(nullptr));
@@ -62,11 +68,12 @@ void with_backend(const std::string& name, F&& f) {
   with_backend_type(name, [&](auto* tag) { f(std::remove_pointer_t<decltype(tag)>()); });
 }
 
-/// Kokkos::initialize / finalize around a run. Sets OMP_PROC_BIND=false when unset, which is libgomp's
-/// default anyway, because Kokkos 3.4 otherwise prints a warning to stdout on every start.
+/// Kokkos::initialize / finalize around a run on the backend `backend` (an available_backends() name): OpenMP
+/// starts with one thread for `serial`. Sets OMP_PROC_BIND=false when unset, which is libgomp's default anyway,
+/// because Kokkos 3.4 otherwise prints a warning to stdout on every start.
 class KokkosSession {
  public:
-  KokkosSession();
+  explicit KokkosSession(const std::string& backend);
   ~KokkosSession();
   KokkosSession(const KokkosSession&) = delete;
   KokkosSession& operator=(const KokkosSession&) = delete;

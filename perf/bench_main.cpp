@@ -6,7 +6,7 @@
 #include <benchmark/benchmark.h>
 
 int main(int argc, char** argv) {
-  kushner::KokkosSession kokkos;
+  kushner::KokkosSession kokkos(kushner::available_backends().front());
   ::benchmark::Initialize(&argc, argv);
   if (::benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   const kushner::BackendDescription backend = kushner::describe_backend(kushner::available_backends().front());

@@ -44,7 +44,7 @@ void dump(const char* label, Model model, int members, int particles, int steps,
 }  // namespace kushner
 
 int main(int argc, char** argv) {
-  kushner::KokkosSession session;
+  kushner::KokkosSession session(kushner::selected_backend());
   const bool car = argc > 1 && std::string(argv[1]) == "car";
   kushner::with_backend(kushner::selected_backend(), [car](const auto& space) {
     using Space = std::decay_t<decltype(space)>;

@@ -196,16 +196,17 @@ int run_reproduce(const ReproduceOptions& options, const RunContext& context_in)
   RunContext context = context_in;
   context.seed = static_cast<std::uint32_t>(settings.seed);
   // A deterministic example is one member stepped tens of thousands of times: OpenMP's fork and join per kernel,
-  // or a GPU's launch and copy latency per step, costs far more than the work (basin-car-filter: 14 s on Serial,
-  // over 200 s on an H100). Unless KUSHNER_BACKEND asks otherwise, it runs on Serial, which gives the same bits
-  // as OpenMP. So does an example without a particle filter (basin-car-controller: 1000 members of dimension 2).
+  // or a GPU's launch and copy latency per step, costs far more than the work (basin-car-filter: 18 s on one
+  // thread, over 200 s on an H100). Unless KUSHNER_BACKEND asks otherwise, it runs on `serial` (the host on one
+  // thread), which gives the same bits as more threads. So does an example without a particle filter
+  // (basin-car-controller: 1000 members of dimension 2).
   const char* asked = std::getenv("KUSHNER_BACKEND");
   const std::vector<std::string> backends = available_backends();
   if ((!example.stochastic || example.particles == 0) && (asked == nullptr || *asked == '\0') &&
       context.backend != "serial" && std::find(backends.begin(), backends.end(), "serial") != backends.end())
     context.backend = "serial";
   const OutputDirectory out(options.out, "--out");
-  KokkosSession kokkos;
+  KokkosSession kokkos(context.backend);
   ExampleResult result = example.run(settings, context, out);
 
   const std::string table_md = result.table.markdown(result.notes);

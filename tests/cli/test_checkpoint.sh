@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Checkpoint and resume (issue 17 part 3): `kushner compare` (PF on, 2000 members) killed with SIGKILL at three
 # points, each time resumed with `kushner resume DIR`, writes every output file byte for byte as a run never
-# stopped (Serial, and OpenMP on 2 threads); SIGINT and SIGTERM save a checkpoint and stop cleanly; a
+# stopped (serial, and OpenMP on 2 threads); SIGINT and SIGTERM save a checkpoint and stop cleanly; a
 # checkpoint that is missing, truncated, corrupt, of another version or of a changed model file is refused
 # with one line and leaves the results already written intact.
 # KUSHNER_CHECKPOINT_BACKENDS (default "serial openmp") names the backends of the SIGKILL runs (the first also

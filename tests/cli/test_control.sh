@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# `kushner control`: artefacts, the same bytes on 1 and 2 threads and on Serial (host backends: host_backend in
+# `kushner control`: artefacts, the same bytes on 1 and 2 threads and on serial (host backends: host_backend in
 # lib.sh; a CUDA build's default is left to tests/cli/test_filter_determinism.sh's tolerance), every controller's entry in
 # summary.json, the HJB reference below the controllers, and bad input refused with one line, exit 2, nothing
 # written.

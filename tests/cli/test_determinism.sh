@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Same seed, same numbers: timeseries.csv byte-identical on 1 and 2 OpenMP threads and on the Serial backend;
+# Same seed, same numbers: timeseries.csv byte-identical on 1 and 2 OpenMP threads and on the serial backend (one host thread);
 # summary.json identical apart from the "backend" and "timing" fields (timing: wall times, never the same twice).
 set -euo pipefail
 kushner=$1

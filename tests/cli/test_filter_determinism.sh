@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # `kushner filter`: same seed, same numbers. timeseries.csv byte-identical on 1 and 2 OpenMP threads and on the
-# Serial backend; summary.json identical apart from the "backend" and "timing" (wall times) fields; on a GPU, equal to a stated tolerance.
+# serial backend (one host thread); summary.json identical apart from the "backend" and "timing" (wall times) fields; on a GPU, equal to a stated tolerance.
 set -euo pipefail
 kushner=$1
 source "$(dirname "$0")/lib.sh"

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Same seed, same bits: the particle filter's per-member outputs (tests/particle_filter_dump.cpp) are
-# byte-identical on 1 and 2 OpenMP threads and on the Serial backend; where the CUDA backend is built, equal to
+# byte-identical on 1 and 2 OpenMP threads and on the serial backend (one host thread); where the CUDA backend is built, equal to
 # the host's to 1e-12 relative (below magnitude 1: absolute), with the same resampling counts, for these models
 # and for Basin's car (no process noise, tan drift).
 set -euo pipefail
@@ -14,7 +14,7 @@ OMP_NUM_THREADS=2 KUSHNER_BACKEND=openmp "$dump" > "$work/omp2"
 KUSHNER_BACKEND=serial "$dump" > "$work/serial"
 [ "$(wc -l < "$work/omp1")" -eq 41 ] || fail "expected 41 member lines, got $(wc -l < "$work/omp1")"
 cmp "$work/omp1" "$work/omp2" || fail "particle filter differs between 1 and 2 OpenMP threads"
-cmp "$work/omp1" "$work/serial" || fail "particle filter differs between OpenMP and Serial"
+cmp "$work/omp1" "$work/serial" || fail "particle filter differs between OpenMP and serial"
 echo "ok: particle filter identical on omp1, omp2, serial ($(wc -l < "$work/omp1") members)"
 
 if grep -qw cuda <<<"$(built_backends)"; then

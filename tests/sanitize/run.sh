@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The test suite under sanitizers, Kokkos built with them; any report ends the test that meets it, so a clean ctest
 # run is 0 reports.
-#   tests/sanitize/run.sh [BUILD_DIR]      AddressSanitizer + UndefinedBehaviorSanitizer (GCC; Serial and OpenMP
-#                                          backends; default BUILD_DIR: build-sanitize)
+#   tests/sanitize/run.sh [BUILD_DIR]      AddressSanitizer + UndefinedBehaviorSanitizer (GCC; the OpenMP
+#                                          backend; default BUILD_DIR: build-sanitize)
 #   KUSHNER_SANITIZE=thread tests/sanitize/run.sh build-tsan
 #                                          ThreadSanitizer on the OpenMP backend: clang++-14 with LLVM's OpenMP
 #                                          runtime and its TSan tool (Archer, libomp-14-dev), which tells TSan about
