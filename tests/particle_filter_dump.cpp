@@ -44,9 +44,10 @@ void dump(const char* label, Model model, int members, int particles, int steps,
 }  // namespace kushner
 
 int main(int argc, char** argv) {
-  kushner::KokkosSession session(kushner::selected_backend());
+  const std::string backend = kushner::selected_backend();
+  kushner::KokkosSession session(backend);
   const bool car = argc > 1 && std::string(argv[1]) == "car";
-  kushner::with_backend(kushner::selected_backend(), [car](const auto& space) {
+  kushner::with_backend(backend, [car](const auto& space) {
     using Space = std::decay_t<decltype(space)>;
     if (car) {
       kushner::dump<Space>("car", kushner::CarModel{}, 500, 1024, 100, 5e-3, kushner::ResamplingScheme::systematic);
