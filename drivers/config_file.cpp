@@ -2,6 +2,8 @@
 
 #include "core/errors.hpp"
 
+#include <CLI/CLI.hpp>
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>

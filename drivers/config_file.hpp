@@ -2,7 +2,7 @@
 // `--config FILE` for a subcommand: CLI11 reads config files for the top-level app only, so the file's
 // TOML/INI items become command-line arguments (`--key=value`), placed before the real command line so that
 // options given there win. Keys are the long option names; a `[simulate]`-style section is optional.
-#include <CLI/CLI.hpp>
+#include "drivers/cli_app.hpp"
 
 #include <string>
 #include <vector>

@@ -1,5 +1,7 @@
 #include "drivers/control_options.hpp"
 
+#include <CLI/CLI.hpp>
+
 namespace kushner {
 
 void add_control_options(CLI::App& app, ControlOptions& o) {

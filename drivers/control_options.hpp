@@ -1,9 +1,8 @@
 #pragma once
 // Options of `kushner control`: the run options, the controllers LAW@ESTIMATOR (and the seeds' aliases), the cost
 // weights, and the estimators' settings (the filters' options and the particle filter's, as for `compare`).
+#include "drivers/cli_app.hpp"
 #include "drivers/filter_options.hpp"
-
-#include <CLI/CLI.hpp>
 
 #include <string>
 #include <utility>

@@ -3,6 +3,8 @@
 #include "core/errors.hpp"
 #include "kernels/filters/filter_list.hpp"
 
+#include <CLI/CLI.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <optional>

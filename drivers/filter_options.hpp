@@ -2,10 +2,9 @@
 // Options of `kushner filter` and `kushner compare`: the run options shared with `simulate`, which filters,
 // the settings of the filters that have any (the particle filter's among them), and what `compare` adds.
 #include "core/options.hpp"
+#include "drivers/cli_app.hpp"
 #include "drivers/run_options.hpp"
 #include "engine/particle_reference.hpp"
-
-#include <CLI/CLI.hpp>
 
 #include <map>
 #include <string>

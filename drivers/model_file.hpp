@@ -4,10 +4,10 @@
 // its time and dimension.
 #include "core/errors.hpp"
 #include "models/discrete_polynomial_model.hpp"
-#include "models/model_checks.hpp"
 #include "models/parameters.hpp"
 #include "models/polynomial_model.hpp"
 #include "models/polynomial_spec.hpp"
+#include "models/registry.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -155,9 +155,9 @@ void with_model_file(const std::string& path, const std::vector<std::string>& se
   }
   auto run = [&](auto* tag) {
     using Model = std::remove_pointer_t<decltype(tag)>;
-    Model model = make_polynomial_model<Model::state_dim, Model>(spec, &source);
+    Model from_file = make_polynomial_model<Model::state_dim, Model>(spec, &source);
     ParameterRecorder settable;
-    model.parameters(settable);
+    from_file.parameters(settable);
     std::string names;
     for (const auto& e : settable.entries()) names += (names.empty() ? "" : ", ") + e.name;
     for (const auto& assignment : assignments) {
@@ -166,8 +166,7 @@ void with_model_file(const std::string& path, const std::vector<std::string>& se
       KUSHNER_INPUT_REQUIRE(known, "--set " << assignment.first << ": a --model-file model takes " << names
                                             << " (the other coefficients are edited in " << path << ")");
     }
-    apply_parameters(model, assignments);
-    validate_model(model);
+    const Model model = configured_model(std::move(from_file), assignments);
     f(model);
   };
   if (spec.discrete)

@@ -2,6 +2,8 @@
 
 #include "core/errors.hpp"
 
+#include <CLI/CLI.hpp>
+
 #include <cmath>
 #include <limits>
 

@@ -1,8 +1,7 @@
 #pragma once
 // Options shared by the commands that run a bank (simulate, filter, compare), checked once here.
+#include "drivers/cli_app.hpp"
 #include "engine/time_grid.hpp"
-
-#include <CLI/CLI.hpp>
 
 #include <cstdint>
 #include <string>

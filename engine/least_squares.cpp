@@ -126,9 +126,11 @@ LeastSquaresEstimate batch_least_squares(const std::vector<ObservationBlock>& bl
   return {qr.solve(b), 0.5 * (P + P.transpose())};
 }
 
-InformationFilter::InformationFilter(const InformationPrior& prior) : Y_(prior.Y), y_(prior.y) { check_prior(prior); }
+LeastSquaresInformation::LeastSquaresInformation(const InformationPrior& prior) : Y_(prior.Y), y_(prior.y) {
+  check_prior(prior);
+}
 
-void InformationFilter::add(const ObservationBlock& block) {
+void LeastSquaresInformation::add(const ObservationBlock& block) {
   check_block(block, y_.size(), "information filter: block");
   const Eigen::LLT<Eigen::MatrixXd> llt(block.R);
   const Eigen::MatrixXd Rinv_H = llt.solve(block.H);
@@ -137,15 +139,15 @@ void InformationFilter::add(const ObservationBlock& block) {
   y_ += Rinv_H.transpose() * block.z;  // (4.16): P_N^-1 x_N = P_{N-1}^-1 x_{N-1} + H^T R^-1 z
 }
 
-bool InformationFilter::determined() const {
+bool LeastSquaresInformation::determined() const {
   if (Y_.isZero(0.0)) return false;
   const Eigen::LLT<Eigen::MatrixXd> llt(Y_);
   return llt.info() == Eigen::Success && llt.rcond() > singular_rcond;
 }
 
-long InformationFilter::rank() const { return numerical_rank(Y_); }
+long LeastSquaresInformation::rank() const { return numerical_rank(Y_); }
 
-LeastSquaresEstimate InformationFilter::estimate() const {
+LeastSquaresEstimate LeastSquaresInformation::estimate() const {
   if (!determined()) throw_undetermined(numerical_rank(Y_), y_.size());
   const Eigen::LLT<Eigen::MatrixXd> llt(Y_);
   const Eigen::MatrixXd Linv = inverse_lower(llt.matrixL());

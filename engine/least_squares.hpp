@@ -2,9 +2,9 @@
 // A constant parameter vector theta observed in blocks z_k = H_k theta + v_k, v_k ~ N(0, R_k) independent,
 // with prior information (Y0, y0) = (P0^-1, P0^-1 theta0), Y0 = 0 for none: seed 004 (4.8)-(4.17). The three
 // estimators below are the same estimate (4.17) computed three ways, which is what (4.9)-(4.17) show:
-//   batch_least_squares    the weighted least-squares problem as a whole, by QR of the whitened rows;
-//   RecursiveLeastSquares  the filter's gain form (4.9), one block at a time (the Kalman update with Phi = I);
-//   InformationFilter      the information form (4.11), (4.16): Y += H^T R^-1 H, y += H^T R^-1 z.
+//   batch_least_squares      the weighted least-squares problem as a whole, by QR of the whitened rows;
+//   RecursiveLeastSquares    the filter's gain form (4.9), one block at a time (the Kalman update with Phi = I);
+//   LeastSquaresInformation  the information form (4.11), (4.16): Y += H^T R^-1 H, y += H^T R^-1 z.
 // Host code (Eigen). Bad input (shapes, a R_k that is not positive definite, an estimate asked for while the
 // information is singular) is an InputError with a one-line message.
 #include "engine/sampled_data.hpp"
@@ -48,9 +48,9 @@ LeastSquaresEstimate batch_least_squares(const std::vector<ObservationBlock>& bl
 
 /// The information form (4.11), (4.13), (4.16): sums of H^T R^-1 H and H^T R^-1 z; the estimate solves
 /// Y theta = y by Cholesky.
-class InformationFilter {
+class LeastSquaresInformation {
  public:
-  explicit InformationFilter(const InformationPrior& prior);
+  explicit LeastSquaresInformation(const InformationPrior& prior);
   void add(const ObservationBlock& block);
   /// Whether Y is numerically nonsingular (its reciprocal condition number above 1e-12).
   bool determined() const;
@@ -82,7 +82,7 @@ class RecursiveLeastSquares {
   LeastSquaresEstimate estimate() const;
 
  private:
-  InformationFilter start_;
+  LeastSquaresInformation start_;
   bool started_ = false;
   GaussianEstimate estimate_;
 };

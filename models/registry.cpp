@@ -4,6 +4,13 @@
 
 namespace kushner {
 
+#define KUSHNER_CONFIGURED_MODEL(Type) \
+  template Type configured_model<Type>(Type, const std::vector<std::pair<std::string, std::string>>&);
+KUSHNER_CONTINUOUS_MODELS(KUSHNER_CONFIGURED_MODEL)
+KUSHNER_DISCRETE_MODELS(KUSHNER_CONFIGURED_MODEL)
+KUSHNER_FILE_MODELS(KUSHNER_CONFIGURED_MODEL)
+#undef KUSHNER_CONFIGURED_MODEL
+
 std::vector<std::string> model_names() {
   std::vector<std::string> names;
   detail::for_each_model_type([&](auto* tag) {

@@ -59,6 +59,22 @@ std::vector<std::string> model_names();
 /// `kushner models`: names, descriptions, parameters with defaults and meanings.
 nlohmann::json describe_models();
 
+/// `model` with `assignments` ("key", "value") applied and checked: InputError for an unknown key, a malformed value
+/// or an invalid configuration. Compiled once for every model of the lists, in registry.cpp, not in every file that
+/// calls with_model or with_run_model: the parsing and the checks (Eigen's eigensolvers for every covariance).
+template <class Model>
+Model configured_model(Model model, const std::vector<std::pair<std::string, std::string>>& assignments) {
+  apply_parameters(model, assignments);
+  validate_model(model);
+  return model;
+}
+#define KUSHNER_CONFIGURED_MODEL(Type) \
+  extern template Type configured_model<Type>(Type, const std::vector<std::pair<std::string, std::string>>&);
+KUSHNER_CONTINUOUS_MODELS(KUSHNER_CONFIGURED_MODEL)
+KUSHNER_DISCRETE_MODELS(KUSHNER_CONFIGURED_MODEL)
+KUSHNER_FILE_MODELS(KUSHNER_CONFIGURED_MODEL)
+#undef KUSHNER_CONFIGURED_MODEL
+
 /// Builds the model called `name`, applies `sets` ("key=value"), validates it, and calls f(model).
 /// Throws InputError for an unknown model, an unknown key, a malformed value or an invalid configuration.
 template <class F>
@@ -88,9 +104,7 @@ void with_model(const std::string& name, const std::vector<std::string>& sets, F
     } else {
       KUSHNER_INPUT_REQUIRE(dim == 0, "--set dim: model '" << name << "' has a fixed dimension " << Model::state_dim);
     }
-    Model model;
-    apply_parameters(model, assignments);
-    validate_model(model);
+    const Model model = configured_model(Model(), assignments);
     called = true;
     f(model);
   });

@@ -51,7 +51,7 @@ struct Agreement {
 
 Agreement agreement(const std::vector<ObservationBlock>& blocks, const InformationPrior& prior) {
   RecursiveLeastSquares rls(prior);
-  InformationFilter info(prior);
+  LeastSquaresInformation info(prior);
   Agreement worst;
   for (std::size_t k = 0; k < blocks.size(); ++k) {
     rls.add(blocks[k]);
@@ -150,7 +150,7 @@ TEST(LeastSquares, AttitudeAtTheOrbitalFrequencyLeavesRotationsAboutTheFieldUnse
   model.omega = model.orbit_rate;
   std::mt19937_64 rng(5);
   const std::vector<ObservationBlock> blocks = attitude_blocks(model, 10800.0, 10.0, 6, VectorXd::Zero(15), rng);
-  InformationFilter info(InformationPrior::none(15));
+  LeastSquaresInformation info(InformationPrior::none(15));
   for (const auto& b : blocks) info.add(b);
   EXPECT_FALSE(info.determined());
   expect_input_error([&] { info.estimate(); }, "singular (rank 12 of 15)");
@@ -160,7 +160,7 @@ TEST(LeastSquares, AttitudeAtTheOrbitalFrequencyLeavesRotationsAboutTheFieldUnse
 TEST(LeastSquares, RefusesBadInputWithOneLine) {
   const InformationPrior none = InformationPrior::none(2);
   ObservationBlock one{MatrixXd::Identity(1, 2), VectorXd::Ones(1), MatrixXd::Identity(1, 1)};
-  expect_input_error([&] { InformationFilter(none).estimate(); }, "singular (rank 0 of 2)");
+  expect_input_error([&] { LeastSquaresInformation(none).estimate(); }, "singular (rank 0 of 2)");
   expect_input_error([&] { batch_least_squares({one}, none); }, "singular (rank 1 of 2)");
   expect_input_error(
       [&] {
@@ -171,7 +171,7 @@ TEST(LeastSquares, RefusesBadInputWithOneLine) {
       "singular (rank 1 of 2)");
   ObservationBlock wide = one;
   wide.H = MatrixXd::Identity(1, 3);
-  expect_input_error([&] { InformationFilter(none).add(wide); }, "H: is 1x3, expected 1x2");
+  expect_input_error([&] { LeastSquaresInformation(none).add(wide); }, "H: is 1x3, expected 1x2");
   ObservationBlock short_z = one;
   short_z.z = VectorXd::Ones(2);
   expect_input_error([&] { batch_least_squares({short_z}, none); }, "block 1: H: is 1x2, expected 2x2");
@@ -185,7 +185,7 @@ TEST(LeastSquares, RefusesBadInputWithOneLine) {
                      "prior P0: not positive definite (pivot 1)");
   expect_input_error(
       [&] {
-        InformationFilter({MatrixXd::Identity(3, 3), VectorXd::Zero(2)});
+        LeastSquaresInformation({MatrixXd::Identity(3, 3), VectorXd::Zero(2)});
       },
       "prior Y: is 3x3, expected 2x2");
 }

@@ -1,5 +1,7 @@
 #include "drivers/reproduce/reproduce_options.hpp"
 
+#include <CLI/CLI.hpp>
+
 namespace kushner {
 
 void add_reproduce_options(CLI::App& app, ReproduceOptions& o) {

@@ -2,7 +2,7 @@
 // Options of `kushner reproduce NAME --out DIR`. Sizes not given take the example's defaults
 // (drivers/reproduce/reproduce_command.cpp); --members, --particles and --seed apply to the stochastic
 // examples only.
-#include <CLI/CLI.hpp>
+#include "drivers/cli_app.hpp"
 
 #include <optional>
 #include <string>

@@ -105,7 +105,7 @@ ExampleResult reproduce_tarushkin_attitude(const ReproduceSettings& settings, co
 
   std::size_t first = 0;  // the first block count whose information determines the coefficients
   {
-    InformationFilter design(no_prior);
+    LeastSquaresInformation design(no_prior);
     while (first < blocks.size() && !design.determined()) design.add(blocks[first++]);
     KUSHNER_INPUT_REQUIRE(design.determined(), "--dt: " << samples << " samples of tarushkin-attitude do not "
                                                         << "determine the 15 coefficients (rank " << design.rank()
@@ -131,7 +131,7 @@ ExampleResult reproduce_tarushkin_attitude(const ReproduceSettings& settings, co
       }
     }
     RecursiveLeastSquares rls(no_prior);
-    InformationFilter info(no_prior);
+    LeastSquaresInformation info(no_prior);
     std::size_t next = 0;
     for (std::size_t k = 0; k < blocks.size(); ++k) {
       rls.add(blocks[k]);
@@ -170,7 +170,7 @@ ExampleResult reproduce_tarushkin_attitude(const ReproduceSettings& settings, co
   // The rank when omega is the orbital rate: the rotations about the field are then in the series' span.
   AttitudeOscillationModel orbital = model;
   orbital.omega = model.orbit_rate;
-  InformationFilter orbital_info(no_prior);
+  LeastSquaresInformation orbital_info(no_prior);
   for (const ObservationBlock& b : design_blocks(orbital, samples, settings.dt)) orbital_info.add(b);
   const long orbital_rank = orbital_info.rank();
 

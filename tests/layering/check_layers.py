@@ -1,9 +1,11 @@
 #!/usr/bin/env python3
-"""Checks that every quoted #include under the layer folders points the way tests/layering/layers.txt allows.
+"""Checks that every quoted #include under the layer folders points the way tests/layering/layers.txt allows, and
+that no source listed in a kushner_host_only(...) call (cmake/host_only.cmake) includes a Kokkos header, directly or
+through the repository's own headers.
 
-Prints each offending include as `file:line: ...` and exits 1; exits 0 when the tree follows the layers.
+Prints each offending include as `file:line: ...` (or chain) and exits 1; exits 0 when the tree follows both rules.
   check_layers.py [ROOT]          the tree at ROOT (default: the repository holding this script)
-  check_layers.py --self-test     also shows that a wrong include in a scratch tree is caught
+  check_layers.py --self-test     also shows that a wrong include and a host-only file reaching Kokkos are caught
 """
 import os
 import re
@@ -104,17 +106,98 @@ def self_test():
     return True
 
 
+CALL = re.compile(r"kushner_host_only\(([^)]*)\)")
+ANY_INCLUDE = re.compile(r'^\s*#\s*include\s+([<"])([^>"]+)[>"]', re.MULTILINE)
+KOKKOS = re.compile(r"^(impl/)?Kokkos")
+
+
+def listed_sources(root):
+    """(CMakeLists.txt, path) of every literal file named in a kushner_host_only call."""
+    for dirpath, dirnames, files in os.walk(root):
+        dirnames[:] = [d for d in dirnames if not d.startswith((".", "build"))]
+        if "CMakeLists.txt" not in files:
+            continue
+        cmake = os.path.join(dirpath, "CMakeLists.txt")
+        with open(cmake) as f:
+            text = re.sub(r"#[^\n]*", "", f.read())
+        for call in CALL.finditer(text):
+            for name in call.group(1).split():
+                if "${" not in name:  # generated files include nothing of ours
+                    yield cmake, os.path.join(dirpath, name)
+
+
+def kokkos_chain(path, root, seen):
+    """The include chain from path to a Kokkos header, or None."""
+    if path in seen:
+        return None
+    seen.add(path)
+    with open(path, encoding="utf-8", errors="replace") as f:
+        text = f.read()
+    for kind, target in ANY_INCLUDE.findall(text):
+        if kind == "<":
+            if KOKKOS.match(target):
+                return [target]
+            continue
+        for candidate in (os.path.join(root, target), os.path.join(os.path.dirname(path), target)):
+            if os.path.exists(candidate):
+                rest = kokkos_chain(candidate, root, seen)
+                if rest:
+                    return [os.path.relpath(candidate, root)] + rest
+                break
+    return None
+
+
+def check_host_only(root):
+    """Sources named in a kushner_host_only(...) call (cmake/host_only.cmake) that reach a Kokkos header: CUDA builds
+    give them to the host compiler alone, where Kokkos' CUDA headers stop with an #error, and CI's compile check
+    does not compile them at all, so without this a listed file that came to include Kokkos would first fail on the
+    GPU machine."""
+    problems = []
+    for cmake, source in listed_sources(root):
+        if not os.path.exists(source):
+            problems.append(f"{os.path.relpath(cmake, root)}: kushner_host_only names {os.path.relpath(source, root)}, "
+                            f"which does not exist")
+            continue
+        chain = kokkos_chain(source, root, set())
+        if chain:
+            problems.append(f"{os.path.relpath(source, root)} is host-only ({os.path.relpath(cmake, root)}) but "
+                            f"includes Kokkos: {' -> '.join(chain)}")
+    return problems
+
+
+def self_test_host_only():
+    """A listed file that reaches Kokkos through a header of ours must be refused; without that include, accepted."""
+    with tempfile.TemporaryDirectory() as scratch:
+        os.makedirs(os.path.join(scratch, "engine"))
+        with open(os.path.join(scratch, "engine", "CMakeLists.txt"), "w") as f:
+            f.write("kushner_host_only(plain.cpp)  # no Kokkos\n")
+        with open(os.path.join(scratch, "engine", "space.hpp"), "w") as f:
+            f.write("#pragma once\n#include <Kokkos_Core.hpp>\n")
+        with open(os.path.join(scratch, "engine", "plain.cpp"), "w") as f:
+            f.write('#include <vector>\n')
+        good = check_host_only(scratch)
+        with open(os.path.join(scratch, "engine", "plain.cpp"), "a") as f:
+            f.write('#include "engine/space.hpp"\n')
+        bad = check_host_only(scratch)
+    if good or len(bad) != 1 or "engine/space.hpp -> Kokkos_Core.hpp" not in bad[0]:
+        print(f"self-test failed: clean host-only tree gave {good}, Kokkos through a header gave {bad}")
+        return False
+    print(f"self-test: a host-only file reaching Kokkos is refused: {bad[0]}")
+    return True
+
+
 def main(argv):
     args = [a for a in argv[1:] if a != "--self-test"]
     root = os.path.abspath(args[0]) if args else os.path.dirname(os.path.dirname(HERE))
-    ok = self_test() if "--self-test" in argv else True
-    problems = check(root)
+    ok = (self_test() and self_test_host_only()) if "--self-test" in argv else True
+    problems = check(root) + check_host_only(root)
     for p in problems:
         print(p)
     if problems:
-        print(f"{len(problems)} include(s) point the wrong way (tests/layering/layers.txt)")
+        print(f"{len(problems)} include(s) point the wrong way (tests/layering/layers.txt, cmake/host_only.cmake)")
         return 1
-    print(f"layers: every include under {root} points the way tests/layering/layers.txt allows")
+    print(f"layers: every include under {root} points the way tests/layering/layers.txt allows; none of the "
+          f"{sum(1 for _ in listed_sources(root))} host-only sources includes Kokkos")
     return 0 if ok else 1
 
 
