@@ -15,7 +15,7 @@ import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 RULES = os.path.join(HERE, "layers.txt")
-INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"')
+INCLUDE = re.compile(r'^\s*#\s*include\s+([<"])([^>"]+)[>"]')  # the bracket kind, the path
 SOURCES = (".hpp", ".cpp", ".h", ".cu", ".in")
 
 
@@ -68,9 +68,9 @@ def check(root):
                 with open(path, encoding="utf-8", errors="replace") as f:
                     for number, line in enumerate(f, 1):
                         m = INCLUDE.match(line)
-                        if not m:
+                        if not m or m.group(1) == "<":
                             continue
-                        target = m.group(1)
+                        target = m.group(2)
                         first = target.split("/", 1)[0]
                         if target in generated:
                             if top_layer(layer) not in generated[target]:
@@ -86,18 +86,21 @@ def check(root):
     return problems
 
 
+def write_file(root, relpath, text, mode="w"):
+    """Writes (or with mode "a" appends) text to root/relpath, making its folder: the self-tests' scratch trees."""
+    path = os.path.join(root, relpath)
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(path, mode) as f:
+        f.write(text)
+
+
 def self_test():
     """A scratch tree with one arrow the wrong way must be refused, and the same tree without it accepted."""
     with tempfile.TemporaryDirectory() as scratch:
-        for folder in ("core", "kernels", "engine"):
-            os.makedirs(os.path.join(scratch, folder))
-        with open(os.path.join(scratch, "core", "math.hpp"), "w") as f:
-            f.write("#pragma once\n")
-        with open(os.path.join(scratch, "engine", "bank.hpp"), "w") as f:
-            f.write('#include "core/math.hpp"\n')
+        write_file(scratch, "core/math.hpp", "#pragma once\n")
+        write_file(scratch, "engine/bank.hpp", '#include "core/math.hpp"\n')
         good = check(scratch)
-        with open(os.path.join(scratch, "kernels", "step.hpp"), "w") as f:
-            f.write('#include "core/math.hpp"\n#include "engine/bank.hpp"\n')
+        write_file(scratch, "kernels/step.hpp", '#include "core/math.hpp"\n#include "engine/bank.hpp"\n')
         bad = check(scratch)
     if good or len(bad) != 1 or not bad[0].startswith("kernels/step.hpp:2: kernels/ includes engine/bank.hpp"):
         print(f"self-test failed: clean tree gave {good}, wrong include gave {bad}")
@@ -107,7 +110,6 @@ def self_test():
 
 
 CALL = re.compile(r"kushner_host_only\(([^)]*)\)")
-ANY_INCLUDE = re.compile(r'^\s*#\s*include\s+([<"])([^>"]+)[>"]', re.MULTILINE)
 KOKKOS = re.compile(r"^(impl/)?Kokkos")
 
 
@@ -132,8 +134,8 @@ def kokkos_chain(path, root, seen):
         return None
     seen.add(path)
     with open(path, encoding="utf-8", errors="replace") as f:
-        text = f.read()
-    for kind, target in ANY_INCLUDE.findall(text):
+        includes = [m.groups() for m in map(INCLUDE.match, f) if m]
+    for kind, target in includes:
         if kind == "<":
             if KOKKOS.match(target):
                 return [target]
@@ -147,13 +149,13 @@ def kokkos_chain(path, root, seen):
     return None
 
 
-def check_host_only(root):
+def check_host_only(root, listed):
     """Sources named in a kushner_host_only(...) call (cmake/host_only.cmake) that reach a Kokkos header: CUDA builds
     give them to the host compiler alone, where Kokkos' CUDA headers stop with an #error, and CI's compile check
     does not compile them at all, so without this a listed file that came to include Kokkos would first fail on the
     GPU machine."""
     problems = []
-    for cmake, source in listed_sources(root):
+    for cmake, source in listed:
         if not os.path.exists(source):
             problems.append(f"{os.path.relpath(cmake, root)}: kushner_host_only names {os.path.relpath(source, root)}, "
                             f"which does not exist")
@@ -168,17 +170,12 @@ def check_host_only(root):
 def self_test_host_only():
     """A listed file that reaches Kokkos through a header of ours must be refused; without that include, accepted."""
     with tempfile.TemporaryDirectory() as scratch:
-        os.makedirs(os.path.join(scratch, "engine"))
-        with open(os.path.join(scratch, "engine", "CMakeLists.txt"), "w") as f:
-            f.write("kushner_host_only(plain.cpp)  # no Kokkos\n")
-        with open(os.path.join(scratch, "engine", "space.hpp"), "w") as f:
-            f.write("#pragma once\n#include <Kokkos_Core.hpp>\n")
-        with open(os.path.join(scratch, "engine", "plain.cpp"), "w") as f:
-            f.write('#include <vector>\n')
-        good = check_host_only(scratch)
-        with open(os.path.join(scratch, "engine", "plain.cpp"), "a") as f:
-            f.write('#include "engine/space.hpp"\n')
-        bad = check_host_only(scratch)
+        write_file(scratch, "engine/CMakeLists.txt", "kushner_host_only(plain.cpp)  # no Kokkos\n")
+        write_file(scratch, "engine/space.hpp", "#pragma once\n#include <Kokkos_Core.hpp>\n")
+        write_file(scratch, "engine/plain.cpp", "#include <vector>\n")
+        good = check_host_only(scratch, list(listed_sources(scratch)))
+        write_file(scratch, "engine/plain.cpp", '#include "engine/space.hpp"\n', mode="a")
+        bad = check_host_only(scratch, list(listed_sources(scratch)))
     if good or len(bad) != 1 or "engine/space.hpp -> Kokkos_Core.hpp" not in bad[0]:
         print(f"self-test failed: clean host-only tree gave {good}, Kokkos through a header gave {bad}")
         return False
@@ -190,14 +187,15 @@ def main(argv):
     args = [a for a in argv[1:] if a != "--self-test"]
     root = os.path.abspath(args[0]) if args else os.path.dirname(os.path.dirname(HERE))
     ok = (self_test() and self_test_host_only()) if "--self-test" in argv else True
-    problems = check(root) + check_host_only(root)
+    host_only = list(listed_sources(root))
+    problems = check(root) + check_host_only(root, host_only)
     for p in problems:
         print(p)
     if problems:
         print(f"{len(problems)} include(s) point the wrong way (tests/layering/layers.txt, cmake/host_only.cmake)")
         return 1
     print(f"layers: every include under {root} points the way tests/layering/layers.txt allows; none of the "
-          f"{sum(1 for _ in listed_sources(root))} host-only sources includes Kokkos")
+          f"{len(host_only)} host-only sources includes Kokkos")
     return 0 if ok else 1
 
 
