@@ -5,7 +5,7 @@
 #include "core/errors.hpp"
 #include "drivers/commands.hpp"
 #include "drivers/config_file.hpp"
-#include "engine/backend.hpp"
+#include "engine/backend_session.hpp"
 #include "engine/processes.hpp"
 #include "engine/run_checkpointing.hpp"
 

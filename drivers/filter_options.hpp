@@ -4,7 +4,7 @@
 #include "core/options.hpp"
 #include "drivers/cli_app.hpp"
 #include "drivers/run_options.hpp"
-#include "engine/particle_reference.hpp"
+#include "engine/particle_settings.hpp"
 
 #include <map>
 #include <string>

@@ -1,7 +1,7 @@
 #include "drivers/commands.hpp"
 #include "drivers/filter_options.hpp"
 #include "drivers/filter_selection.hpp"
-#include "engine/backend.hpp"
+#include "engine/backend_session.hpp"
 #include "models/registry.hpp"
 
 #include <cmath>

@@ -2,7 +2,7 @@
 
 #include "core/collectives.hpp"
 #include "core/errors.hpp"
-#include "engine/backend.hpp"
+#include "engine/backend_session.hpp"
 #include "engine/processes.hpp"
 
 #include <cstdio>

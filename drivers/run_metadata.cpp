@@ -1,7 +1,7 @@
 #include "drivers/run_metadata.hpp"
 
 #include "core/collectives.hpp"
-#include "engine/backend.hpp"
+#include "engine/backend_session.hpp"
 #include "engine/version.hpp"
 
 #include <chrono>

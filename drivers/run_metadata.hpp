@@ -1,6 +1,6 @@
 #pragma once
 // What every output file records about the run that made it: command, seed, version, backend.
-#include "engine/backend.hpp"
+#include "engine/backend_session.hpp"
 #include "engine/version.hpp"
 
 #include <nlohmann/json.hpp>

@@ -3,13 +3,12 @@
 // where: KUSHNER_BACKEND=serial|openmp|cuda (default: Kokkos' default execution space) and OMP_NUM_THREADS.
 // So the recorded command, and every per-member number, is the same whatever backend ran it.
 #include "core/errors.hpp"
+#include "engine/backend_session.hpp"
 
 #include <Kokkos_Core.hpp>
 
-#include <optional>
 #include <string>
 #include <type_traits>
-#include <vector>
 
 // The backend `serial` is the host on one thread. Where OpenMP is built it is OpenMP's code on one thread
 // (KokkosSession starts OpenMP with one thread): the same bits as Kokkos::Serial (the reproducibility tests compared
@@ -25,26 +24,6 @@
 #endif
 
 namespace kushner {
-
-/// Backends compiled into this binary, default first.
-std::vector<std::string> available_backends();
-
-/// KUSHNER_BACKEND if set (checked against available_backends(): InputError otherwise), else the default.
-/// InputError in a CUDA build where no GPU is usable (Kokkos could not start, whatever the backend).
-std::string selected_backend();
-
-/// What a run records about where it ran. Needs Kokkos initialized.
-struct BackendDescription {
-  std::string name;    // an available_backends() name
-  std::string kokkos;  // Kokkos version, "3.4.1"
-  int threads = 0;     // host backends; 0 on a GPU
-  std::string device;  // GPU name; empty on the host
-};
-BackendDescription describe_backend(const std::string& name);
-
-/// Bytes of memory the backend `name` can still allocate: free device memory for a GPU, MemAvailable of
-/// /proc/meminfo on the host; nullopt where unknown. For the GPU it needs Kokkos initialized.
-std::optional<double> available_memory_bytes(const std::string& name);
 
 /// Calls f(tag), tag a null pointer to the execution space called `name`: for what depends on its type only,
 /// also before Kokkos is initialized (an instance needs an initialized Kokkos; Kokkos 3.4's Cuda() complains).
@@ -67,16 +46,5 @@ template <class F>
 void with_backend(const std::string& name, F&& f) {
   with_backend_type(name, [&](auto* tag) { f(std::remove_pointer_t<decltype(tag)>()); });
 }
-
-/// Kokkos::initialize / finalize around a run on the backend `backend` (an available_backends() name): OpenMP
-/// starts with one thread for `serial`. Sets OMP_PROC_BIND=false when unset, which is libgomp's default anyway,
-/// because Kokkos 3.4 otherwise prints a warning to stdout on every start.
-class KokkosSession {
- public:
-  explicit KokkosSession(const std::string& backend);
-  ~KokkosSession();
-  KokkosSession(const KokkosSession&) = delete;
-  KokkosSession& operator=(const KokkosSession&) = delete;
-};
 
 }  // namespace kushner

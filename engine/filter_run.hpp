@@ -14,6 +14,7 @@
 #include "engine/particle_reference.hpp"
 #include "engine/progress_callback.hpp"
 #include "engine/run_checkpointing.hpp"
+#include "engine/state_archive.hpp"
 #include "engine/time_grid.hpp"
 
 #include <Kokkos_Core.hpp>

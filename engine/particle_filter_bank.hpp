@@ -21,6 +21,7 @@
 #include "core/eigen_helpers.hpp"
 #include "core/errors.hpp"
 #include "core/linear_algebra.hpp"
+#include "engine/particle_settings.hpp"
 #include "engine/shared_instances.hpp"
 #include "kernels/bank.hpp"
 #include "kernels/for_each_member.hpp"
@@ -28,12 +29,10 @@
 #include "kernels/particle_filter/copy_listed_members.hpp"
 #include "kernels/particle_filter/particle_block_step.hpp"
 #include "kernels/particle_filter/particle_posterior.hpp"
-#include "kernels/particle_filter/particle_precision.hpp"
 #include "kernels/particle_filter/particle_resample_step.hpp"
 #include "kernels/particle_filter/particle_team_pair_step.hpp"
 #include "kernels/particle_filter/particle_team_step.hpp"
 #include "kernels/particle_filter/resampling.hpp"
-#include "kernels/particle_filter/resampling_scheme.hpp"
 #include "kernels/particle_filter/tuning.hpp"
 
 #include <Kokkos_Core.hpp>
@@ -55,25 +54,6 @@ constexpr const char* particle_filter_unsupported() {
   if (Model::state_dim > max_particle_filter_dim) return "state dimension above 4";
   return nullptr;
 }
-
-/// Which step kernel runs: the host's SIMD block kernel, or the team kernel written for GPUs (which also
-/// runs on host spaces, for testing it where there is no GPU).
-enum class ParticleKernel { automatic, host_block, team };
-
-/// Where the particles start: the filters' prior N(prior_mean, prior_cov) (default: the reference then
-/// answers "what is the optimal estimate given what the filters assume"), or the truths' law
-/// N(x0_mean, x0_cov).
-enum class ParticleInitialLaw { prior, truth };
-
-struct ParticleFilterOptions {
-  ResamplingScheme scheme = ResamplingScheme::systematic;
-  double ess_threshold = 0.5;  // resample a member when ESS < ess_threshold * N
-  ParticleInitialLaw initial_law = ParticleInitialLaw::prior;
-  ParticleKernel kernel = ParticleKernel::automatic;
-  int team_size = 0;             // team kernel and resampling: 0 = the backend's default
-  int particles_per_thread = 0;  // team kernel: 0 = device_particles_per_thread
-  ParticlePrecision precision = ParticlePrecision::fp64;
-};
 
 /// Real: how the particles and log-weights are stored, double, or float for the fp32 precision (the constructor
 /// requires options.precision to match; particle_reference.hpp picks the class).

@@ -20,24 +20,6 @@
 
 namespace kushner {
 
-/// When the particle filter takes two steps per call (ParticleFilterBank::step_pair) and the bank scores one
-/// step behind for it: where its kernel fuses the two steps into one pass over the particles (the GPU's), always
-/// (the two steps one after the other where it does not fuse them: the same numbers as `never`, which tests
-/// check), or never.
-enum class StepPairs { automatic, always, never };
-
-/// Whether the particle filter takes step pairs under `step_pairs`, given whether its kernel fuses them.
-inline bool takes_step_pairs(StepPairs step_pairs, bool fuses) {
-  return step_pairs == StepPairs::always || (step_pairs == StepPairs::automatic && fuses);
-}
-
-/// Particle-filter settings of `kushner filter` and `kushner compare`.
-struct ParticleSettings {
-  int particles = 1024;
-  ParticleFilterOptions options;
-  StepPairs step_pairs = StepPairs::automatic;
-};
-
 template <int N, class MemSpace>
 struct AccumulateEss {
   BankScalar<double, MemSpace> ess;

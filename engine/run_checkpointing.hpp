@@ -3,14 +3,14 @@
 // when to save, where the bytes go, the caller's own state, and the state to continue from. The engine saves
 // between steps, so a checkpoint holds the state after step k; draws are keyed by (seed, stream, member,
 // particle, step), so a run continued from it makes the same numbers as one never stopped.
-#include "engine/state_archive.hpp"
-
 #include <chrono>
 #include <functional>
 #include <stdexcept>
 #include <string>
 
 namespace kushner {
+
+class StateArchive;  // engine/state_archive.hpp (Kokkos): the command line includes this header without Kokkos
 
 struct RunCheckpointing {
   /// Save when this many seconds have passed since the start or the last save; < 0: only on SIGINT/SIGTERM.

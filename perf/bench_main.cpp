@@ -1,6 +1,6 @@
 // Google Benchmark main for kushner: Kokkos initialized once; git hash, backend and threads or device in
 // the benchmark context so that every JSON result says what produced it.
-#include "engine/backend.hpp"
+#include "engine/backend_session.hpp"
 #include "engine/version.hpp"
 
 #include <benchmark/benchmark.h>

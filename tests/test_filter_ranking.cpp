@@ -71,7 +71,7 @@ class PerturbedReference final : public ReferenceEstimator<MemSpace> {
   BankScalar<Status, MemSpace> status() const override { return base_.status(); }
   Fields describe() const override { return base_.describe(); }
 
- private:
+  // public: nvcc refuses an extended __host__ __device__ lambda (KOKKOS_LAMBDA) in a private or protected member.
   void blend() {
     const auto base = base_.mean();
     const auto towards = towards_;
@@ -84,6 +84,8 @@ class PerturbedReference final : public ReferenceEstimator<MemSpace> {
         });
     Space().fence();
   }
+
+ private:
   ReferenceEstimator<MemSpace>& base_;
   BankVector<MemSpace> towards_, mean_;
   double weight_;

@@ -99,13 +99,21 @@ inline void gauss_hermite(int n, std::vector<double>& nodes, std::vector<double>
   }
 }
 
+/// A feedback law (t, x) -> u of one control, for hjb_markov_chain to evaluate. A class template's member alias, so
+/// that `Model` in it is not deduced from the argument: nvcc's front end otherwise refuses a lambda argument (no
+/// matching template), where GCC takes it.
+template <int N>
+struct HjbPolicyOf {
+  using type = std::function<double(double, const Vec<N>&)>;
+};
+
 /// Solves the chain's dynamic programme over [0, T]. With `policy` (a function (t, x) -> u), evaluates that policy
 /// (clamped to the bound) on the same chain instead of minimizing: its J is then the policy's expected cost.
 template <class Model>
-HjbSolution<Model::state_dim> hjb_markov_chain(
-    const Model& model, const QuadraticCost<Model::state_dim, Model::control_dim>& cost, double T,
-    const HjbOptions<Model::state_dim>& options = {},
-    const std::function<double(double, const Vec<Model::state_dim>&)>& policy = nullptr) {
+HjbSolution<Model::state_dim> hjb_markov_chain(const Model& model,
+                                               const QuadraticCost<Model::state_dim, Model::control_dim>& cost,
+                                               double T, const HjbOptions<Model::state_dim>& options = {},
+                                               const typename HjbPolicyOf<Model::state_dim>::type& policy = nullptr) {
   constexpr int n = Model::state_dim, m = Model::control_dim;
   static_assert(n >= 1 && n <= 2, "hjb_markov_chain: dimension 1 or 2");
   static_assert(m == 1, "hjb_markov_chain: one control (exact piecewise-quadratic minimization)");

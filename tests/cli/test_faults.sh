@@ -31,8 +31,15 @@ small=(--members 50 --T 0.1 --dt 0.01 --quiet)
 # address-space limit (a limit makes malloc fail instead of waking the kernel's OOM killer; the check before
 # allocation sees the machine's free memory, which the limit does not lower). AddressSanitizer reserves terabytes
 # of address space for its shadow memory at start, so under it (tests/sanitize/run.sh) no limit can be set.
+# A CUDA build's runtime cannot start under such a limit ("no usable GPU (cudaGetDeviceCount: out of memory)"), so
+# there the GPU's own memory is the limit: a bank larger than any GPU's memory is refused before allocation.
 if ldd "$kushner" 2>/dev/null | grep -q libasan; then
   echo "skipped: out of memory under an address-space limit (kushner is built with AddressSanitizer)"
+elif [[ " $(built_backends) " == *" cuda "* ]]; then
+  expect_fault "--members 40000: the run needs 298 GiB (filter bank 7.63 MiB per member), but cuda has " \
+    filter --model sine --filters EnKBF --enkbf-particles 1000000 --members 40000 --T 0.01 --dt 0.01 \
+    --out "$work/memory" --quiet
+  [ ! -e "$work/memory" ] || fail "out of GPU memory: the refused run created its output directory"
 else
   set +e
   (ulimit -v 600000 && exec "$kushner" filter --filters PF --members 1000 --particles 100000 --T 0.01 --dt 0.01 \
