@@ -5,6 +5,7 @@
 #include "kernels/filters/filter_list.hpp"
 #include "models/cubic_oscillator_model.hpp"
 #include "models/sine_model.hpp"
+#include "perf/bench_timing.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -104,18 +105,8 @@ void BM_FilterBankSegments(benchmark::State& state) {
 template <class Model>
 void BM_TruthStepAlone(benchmark::State& state) {
   const long members = state.range(0);
-  const Space space;
-  TruthBank<Space, Model> bank(space, Model{}, members, 42);
-  long k = 0;
-  for (auto _ : state) {
-    space.fence();
-    Kokkos::Timer timer;
-    bank.step(k++, 1e-3);
-    space.fence();
-    state.SetIterationTime(timer.seconds());
-  }
-  using C = benchmark::Counter;
-  state.counters["member_steps_per_s"] = C(static_cast<double>(members), C::kIsIterationInvariantRate);
+  TruthBank<Space, Model> bank(Space(), Model{}, members, 42);
+  time_truth_steps(state, bank, members);
 }
 
 BENCHMARK_TEMPLATE(BM_FilterBankStep, SineModel)

@@ -6,6 +6,7 @@
 #include "engine/particle_filter_bank.hpp"
 #include "engine/truth_bank.hpp"
 #include "models/sine_model.hpp"
+#include "perf/bench_timing.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -92,29 +93,12 @@ void BM_ParticleFilterStep(benchmark::State& state) {
 /// The physical floor: a deep_copy of the bytes one step moves (half read, half written).
 template <class Model>
 void BM_StreamCopy(benchmark::State& state) {
-  using Space = Kokkos::DefaultExecutionSpace;
   const long particle_count = state.range(0) * state.range(1);
-  const long doubles = particle_count * static_cast<long>(bytes_per_particle_step<Model>() / 16.0);
-  Kokkos::View<double*, Space::memory_space> a("a", doubles), b("b", doubles);
-  Kokkos::deep_copy(a, 1.0);
-  const Space space;
-  for (auto _ : state) {
-    space.fence();
-    Kokkos::Timer timer;
-    Kokkos::deep_copy(space, b, a);
-    space.fence();
-    state.SetIterationTime(timer.seconds());
-  }
+  time_stream_copy(state, particle_count * static_cast<long>(bytes_per_particle_step<Model>() / 16.0));
   using C = benchmark::Counter;
-  state.counters["GB_per_s"] = C(1e-9 * 16.0 * doubles, C::kIsIterationInvariantRate);
   state.counters["particle_steps_per_s"] = C(static_cast<double>(particle_count), C::kIsIterationInvariantRate);
 }
 
-// M x N: the CPU target (100 x 4096), then M.N = 1e6 .. 1e9; sizes past 1e7 only where a GPU runs them.
-// The third argument (GPU team kernel only) is particles per thread, 0 = the default; the fourth, 0, turns
-// resampling off (ESS threshold 0), which shows what resampling costs; the fifth is steps per timed call
-// (2: step_pair, which fuses them where the team kernel runs); the sixth is the precision: 0 fp64, 1 mixed (normals
-// drawn in fp32), 2 fp32 (also particles and log-weights stored in float).
 BENCHMARK_TEMPLATE(BM_ParticleFilterStep, SineModel)
     ->Apply([](benchmark::internal::Benchmark* b) {
       b->ArgNames({"members", "particles", "per_thread", "resample", "steps", "precision"});

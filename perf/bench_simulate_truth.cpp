@@ -3,6 +3,7 @@
 #include "engine/truth_bank.hpp"
 #include "models/cubic_oscillator_model.hpp"
 #include "models/sine_model.hpp"
+#include "perf/bench_timing.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -19,20 +20,11 @@ template <class Model>
 void BM_TruthStep(benchmark::State& state) {
   using Space = Kokkos::DefaultExecutionSpace;
   const long members = state.range(0);
-  const Space space;
-  TruthBank<Space, Model> bank(space, Model{}, members, 42);
-  long k = 0;
-  for (auto _ : state) {
-    space.fence();
-    Kokkos::Timer timer;
-    bank.step(k++, 1e-3);
-    space.fence();
-    state.SetIterationTime(timer.seconds());
-  }
+  TruthBank<Space, Model> bank(Space(), Model{}, members, 42);
+  time_truth_steps(state, bank, members);
   using C = benchmark::Counter;
-  state.counters["member_steps_per_s"] = C(static_cast<double>(members), C::kIsIterationInvariantRate);
   state.counters["GB_per_s"] = C(1e-9 * bytes_per_member_step<Model>() * members, C::kIsIterationInvariantRate);
-  const auto moments = ensemble_moments(space, bank.state());
+  const auto moments = ensemble_moments(Space(), bank.state());
   for (double v : moments.mean)
     if (!std::isfinite(v)) state.SkipWithError("non-finite state");
 }
@@ -40,21 +32,7 @@ void BM_TruthStep(benchmark::State& state) {
 /// The physical floor: copying the bytes one step moves.
 template <class Model>
 void BM_StreamCopy(benchmark::State& state) {
-  using Space = Kokkos::DefaultExecutionSpace;
-  const long members = state.range(0);
-  const long doubles = members * static_cast<long>(bytes_per_member_step<Model>() / 16.0);  // half read, half written
-  Kokkos::View<double*, Space::memory_space> a("a", doubles), b("b", doubles);
-  Kokkos::deep_copy(a, 1.0);
-  const Space space;
-  for (auto _ : state) {
-    space.fence();
-    Kokkos::Timer timer;
-    Kokkos::deep_copy(space, b, a);
-    space.fence();
-    state.SetIterationTime(timer.seconds());
-  }
-  using C = benchmark::Counter;
-  state.counters["GB_per_s"] = C(1e-9 * 16.0 * doubles, C::kIsIterationInvariantRate);
+  time_stream_copy(state, state.range(0) * static_cast<long>(bytes_per_member_step<Model>() / 16.0));
 }
 
 BENCHMARK_TEMPLATE(BM_TruthStep, SineModel)->ArgName("members")->Arg(1 << 20)->Arg(1000000)->UseManualTime();

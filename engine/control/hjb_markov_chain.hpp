@@ -99,9 +99,9 @@ inline void gauss_hermite(int n, std::vector<double>& nodes, std::vector<double>
   }
 }
 
-/// A feedback law (t, x) -> u of one control, for hjb_markov_chain to evaluate. A class template's member alias, so
-/// that `Model` in it is not deduced from the argument: nvcc's front end otherwise refuses a lambda argument (no
-/// matching template), where GCC takes it.
+/// A feedback law (t, x) -> u of one control, for hjb_markov_chain to evaluate. Named through a class template's
+/// member: with the std::function spelled out in the parameter list (Vec<Model::state_dim>), nvcc's front end found
+/// no matching template for a lambda argument, where GCC takes it (CUDA 13).
 template <int N>
 struct HjbPolicyOf {
   using type = std::function<double(double, const Vec<N>&)>;
