@@ -8,7 +8,7 @@ namespace kushner {
 /// "412 B", "3.4 MiB", "2.55 TiB".
 std::string format_bytes(double bytes);
 
-/// InputError unless `bytes` fit in what `backend` can still allocate (engine/backend.hpp); `sizes` names the
+/// InputError unless `bytes` fit in what `backend` can still allocate (engine/backend_session.hpp); `sizes` names the
 /// options that set them ("--members 100000, --particles 1000000"), `breakdown` where they go. Passes where
 /// the free memory is unknown.
 void require_memory_fits(double bytes, const std::string& sizes, const std::string& breakdown,
