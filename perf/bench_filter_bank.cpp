@@ -106,7 +106,7 @@ template <class Model>
 void BM_TruthStepAlone(benchmark::State& state) {
   const long members = state.range(0);
   TruthBank<Space, Model> bank(Space(), Model{}, members, 42);
-  time_truth_steps(state, bank, members);
+  time_truth_steps(state, bank);
 }
 
 BENCHMARK_TEMPLATE(BM_FilterBankStep, SineModel)

@@ -99,6 +99,11 @@ void BM_StreamCopy(benchmark::State& state) {
   state.counters["particle_steps_per_s"] = C(static_cast<double>(particle_count), C::kIsIterationInvariantRate);
 }
 
+// M x N: the CPU target (100 x 4096), then M.N = 1e6 .. 1e9; sizes past 1e7 only where a GPU runs them.
+// The third argument (GPU team kernel only) is particles per thread, 0 = the default; the fourth, 0, turns
+// resampling off (ESS threshold 0), which shows what resampling costs; the fifth is steps per timed call
+// (2: step_pair, which fuses them where the team kernel runs); the sixth is the precision: 0 fp64, 1 mixed (normals
+// drawn in fp32), 2 fp32 (also particles and log-weights stored in float).
 BENCHMARK_TEMPLATE(BM_ParticleFilterStep, SineModel)
     ->Apply([](benchmark::internal::Benchmark* b) {
       b->ArgNames({"members", "particles", "per_thread", "resample", "steps", "precision"});

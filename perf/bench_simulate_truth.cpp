@@ -21,7 +21,7 @@ void BM_TruthStep(benchmark::State& state) {
   using Space = Kokkos::DefaultExecutionSpace;
   const long members = state.range(0);
   TruthBank<Space, Model> bank(Space(), Model{}, members, 42);
-  time_truth_steps(state, bank, members);
+  time_truth_steps(state, bank);
   using C = benchmark::Counter;
   state.counters["GB_per_s"] = C(1e-9 * bytes_per_member_step<Model>() * members, C::kIsIterationInvariantRate);
   const auto moments = ensemble_moments(Space(), bank.state());

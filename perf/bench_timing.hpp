@@ -9,9 +9,10 @@
 
 namespace kushner {
 
-/// Steps `bank` of `members` truths once per iteration (what `kushner simulate` does per step): member_steps_per_s.
+/// Steps `bank` once per iteration (what `kushner simulate` does per step): member_steps_per_s.
 template <class Space, class Model>
-void time_truth_steps(benchmark::State& state, TruthBank<Space, Model>& bank, const long members) {
+void time_truth_steps(benchmark::State& state, TruthBank<Space, Model>& bank) {
+  const auto members = static_cast<double>(bank.state().extent(0));
   const Space space;
   long k = 0;
   for (auto _ : state) {
@@ -22,7 +23,7 @@ void time_truth_steps(benchmark::State& state, TruthBank<Space, Model>& bank, co
     state.SetIterationTime(timer.seconds());
   }
   using C = benchmark::Counter;
-  state.counters["member_steps_per_s"] = C(static_cast<double>(members), C::kIsIterationInvariantRate);
+  state.counters["member_steps_per_s"] = C(members, C::kIsIterationInvariantRate);
 }
 
 /// The physical floor: a deep_copy of `doubles` doubles (half the bytes read, half written) on the default space:
