@@ -346,14 +346,20 @@ struct NothingCounted {
   KOKKOS_INLINE_FUNCTION bool operator()(int, int) const { return false; }
 };
 
-/// The BlockStatistic of every (block, column) pair of `columns` (columns(c): column c's values, value(m)), pair
-/// i = c * blocks + b, and after them the count of every (block, counted column s) pair, i = (num_columns + s) *
-/// blocks + b: one launch for all of an output step's reductions. A column's blocks are independent, and a GPU needs
-/// the threads (one thread per block gave 1e6 members 3907 threads, and the moments took most of an output step).
-/// Two forms, the same bits: one thread per pair (the host's: its lanes are vector lanes), or teams (block_team_policy:
-/// on a GPU a warp per pair, warp_block_statistic; with one thread per pair a GPU's warp read 32 blocks 2 KB apart,
-/// 123 us for 12 columns of 1e6 members on an H100, 2.4x a read of them). Counts are integer sums: any order gives
-/// the same count.
+/// The BlockStatistic of every (block, column) pair of `columns` (columns(c): column c's values, value(m)), and the
+/// count of every (block, counted column s) pair: one launch for all of an output step's reductions. A column's blocks
+/// are independent, and a GPU needs the threads (one thread per block gave 1e6 members 3907 threads, and the moments
+/// took most of an output step). Two forms, the same bits: one thread per pair (the host's: its lanes are vector
+/// lanes), or teams (block_team_policy: on a GPU a warp per pair, warp_block_statistic; with one thread per pair a
+/// GPU's warp read 32 blocks 2 KB apart, 123 us for 12 columns of 1e6 members on an H100, 2.4x a read of them).
+/// Counts are integer sums: any order gives the same count.
+/// Pair i of the one-thread form is block i / P, column (or counted column) i % P, P = num_columns + counted columns:
+/// a host thread's share of the pairs is then whole blocks, the members the bank's own kernels gave that thread. With
+/// the pairs column after column, a thread read every member of its columns (and FiniteRowValue reads every column),
+/// so each line of the bank sat in both cores' caches, and the next step's writes waited for the other core to let
+/// go of it: the cubic oscillator's `simulate` (2 columns, 1e6 members, an output every step, 2 threads) took 1.6 s
+/// against 1.0 s with 5 outputs on the 2-core development machine (how much depends on where its cores sit:
+/// perf/filter_bank.md).
 template <class Columns, class MemSpace, class Counted = NothingCounted>
 struct BlockColumnStatistics {
   Columns columns;
@@ -363,7 +369,7 @@ struct BlockColumnStatistics {
   BlockStatistics<MemSpace> blocks;  // (block, 3 num_columns + counted.columns())
 
   KOKKOS_INLINE_FUNCTION void operator()(const int i) const {
-    const int num_blocks = static_cast<int>(blocks.extent(0)), b = i % num_blocks, c = i / num_blocks;
+    const int pairs_per_block = num_columns + counted.columns(), b = i / pairs_per_block, c = i % pairs_per_block;
     const int begin = b * moment_block_size, end = block_end(b, members);
     if (c < num_columns) {
       store_block_statistic(blocks, num_columns, b, c, block_statistic(columns(c), begin, end));
@@ -374,6 +380,7 @@ struct BlockColumnStatistics {
     }
   }
 
+  /// The team form: pair i = c * blocks + b, so a GPU's neighbouring warps read neighbouring blocks of a column.
   template <class Team>
   KOKKOS_INLINE_FUNCTION void operator()(BlockTeams, const Team& team) const {
     const int num_blocks = static_cast<int>(blocks.extent(0));

@@ -1,5 +1,5 @@
-// Truth simulation step (Euler-Maruyama, all members in one kernel): member-steps per second, next to a
-// deep_copy of the same bytes (the memory floor) in the same binary.
+// Truth simulation step (Euler-Maruyama, all members in one kernel): member-steps per second, alone and with an output
+// step's moments after it, next to a deep_copy of the same bytes (the memory floor) in the same binary.
 #include "engine/truth_bank.hpp"
 #include "models/cubic_oscillator_model.hpp"
 #include "models/sine_model.hpp"
@@ -29,6 +29,14 @@ void BM_TruthStep(benchmark::State& state) {
     if (!std::isfinite(v)) state.SkipWithError("non-finite state");
 }
 
+/// A step and the ensemble moments of the state it leaves: `kushner simulate`'s output step (every step by default).
+template <class Model>
+void BM_OutputStep(benchmark::State& state) {
+  using Space = Kokkos::DefaultExecutionSpace;
+  TruthBank<Space, Model> bank(Space(), Model{}, state.range(0), 42);
+  time_truth_steps(state, bank, [&] { benchmark::DoNotOptimize(ensemble_moments(Space(), bank.state()).mean); });
+}
+
 /// The physical floor: copying the bytes one step moves.
 template <class Model>
 void BM_StreamCopy(benchmark::State& state) {
@@ -39,6 +47,8 @@ BENCHMARK_TEMPLATE(BM_TruthStep, SineModel)->ArgName("members")->Arg(1 << 20)->A
 BENCHMARK_TEMPLATE(BM_StreamCopy, SineModel)->ArgName("members")->Arg(1000000)->UseManualTime();
 BENCHMARK_TEMPLATE(BM_TruthStep, CubicOscillatorModel)->ArgName("members")->Arg(1000000)->UseManualTime();
 BENCHMARK_TEMPLATE(BM_StreamCopy, CubicOscillatorModel)->ArgName("members")->Arg(1000000)->UseManualTime();
+BENCHMARK_TEMPLATE(BM_OutputStep, SineModel)->ArgName("members")->Arg(1000000)->UseManualTime();
+BENCHMARK_TEMPLATE(BM_OutputStep, CubicOscillatorModel)->ArgName("members")->Arg(1000000)->UseManualTime();
 
 }  // namespace
 }  // namespace kushner

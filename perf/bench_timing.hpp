@@ -9,9 +9,15 @@
 
 namespace kushner {
 
-/// Steps `bank` once per iteration (what `kushner simulate` does per step): member_steps_per_s.
-template <class Space, class Model>
-void time_truth_steps(benchmark::State& state, TruthBank<Space, Model>& bank) {
+/// What time_truth_steps does after each step by default: nothing.
+struct NothingAfterStep {
+  void operator()() const {}
+};
+
+/// Steps `bank` once per iteration (what `kushner simulate` does per step), then calls after_step() inside the timing
+/// (an output step's moments): member_steps_per_s.
+template <class Space, class Model, class AfterStep = NothingAfterStep>
+void time_truth_steps(benchmark::State& state, TruthBank<Space, Model>& bank, const AfterStep& after_step = {}) {
   const auto members = static_cast<double>(bank.state().extent(0));
   const Space space;
   long k = 0;
@@ -19,6 +25,7 @@ void time_truth_steps(benchmark::State& state, TruthBank<Space, Model>& bank) {
     space.fence();
     Kokkos::Timer timer;
     bank.step(k++, 1e-3);
+    after_step();
     space.fence();
     state.SetIterationTime(timer.seconds());
   }
