@@ -1,10 +1,9 @@
 #pragma once
 // Eigen on the host: conversions from and to the small fixed-size matrices, the covariance check every input
 // goes through, and the square root that samples a Gaussian with a possibly singular covariance.
+#include "core/eigen_dense.hpp"
 #include "core/errors.hpp"
 #include "core/small_matrix.hpp"
-
-#include <Eigen/Dense>
 
 #include <algorithm>
 #include <cmath>

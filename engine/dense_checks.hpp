@@ -1,7 +1,7 @@
 #pragma once
 // Input checks for the host's dynamic-size Eigen matrices (sampled data, least squares): one-line InputErrors
 // that name the matrix, as a user reads them. The fixed-size models' checks are core/eigen_helpers.hpp's.
-#include <Eigen/Dense>
+#include "core/eigen_dense.hpp"
 
 #include <string>
 

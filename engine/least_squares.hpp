@@ -7,9 +7,8 @@
 //   LeastSquaresInformation  the information form (4.11), (4.16): Y += H^T R^-1 H, y += H^T R^-1 z.
 // Host code (Eigen). Bad input (shapes, a R_k that is not positive definite, an estimate asked for while the
 // information is singular) is an InputError with a one-line message.
+#include "core/eigen_dense.hpp"
 #include "engine/sampled_data.hpp"
-
-#include <Eigen/Dense>
 
 #include <cstddef>
 #include <vector>

@@ -13,6 +13,7 @@
 // outside: 1e-15), spectrally accurate for a smooth integrand once the spacing is below the posterior's width.
 // Its quadrature error is estimated at each step as |mean - mean on every second node| (the rule with twice
 // the spacing), whose largest value over the run describe() reports: it bounds the error of the mean used.
+#include "core/eigen_dense.hpp"
 #include "core/eigen_helpers.hpp"
 #include "core/errors.hpp"
 #include "core/linear_algebra.hpp"
@@ -21,7 +22,6 @@
 #include "kernels/bank.hpp"
 #include "kernels/for_each_member.hpp"
 
-#include <Eigen/Dense>
 #include <Kokkos_Core.hpp>
 
 #include <cmath>

@@ -5,7 +5,7 @@
 // discretization of the state is exact: x[k+1] = Phi x[k] + w[k] with Phi = exp(A dt) and
 // Qd = E w w^T = int_0^dt exp(A s) G G^T exp(A^T s) ds (Van Loan's block exponential), whatever dt.
 // Host code (Eigen), for set-ups, references and tests.
-#include <Eigen/Dense>
+#include "core/eigen_dense.hpp"
 
 namespace kushner {
 

@@ -17,11 +17,9 @@
 #include <type_traits>
 
 namespace kushner {
-namespace {
-
-using Space = Kokkos::DefaultExecutionSpace;
-constexpr double dt = 0.01;
-constexpr double exact = 1e-13;  // relative: only rounding separates the bank from the formulas below
+// The test's models, outside the anonymous namespace: nvcc warns (#177-D) about members of its classes that this file
+// never reads (control_dim, linear_observation), which every model declares.
+namespace single_step_models {
 
 /// dx = -a x dt + q dw, dy = (x + c x^2) dt + r dv: h'' = 2 c, so EKF-DS and SOF have dy terms in P.
 struct QuadraticObservationModel : InitialLaw<1> {
@@ -86,6 +84,16 @@ struct ScalarPolynomialModel : InitialLaw<1> {
     return poly;
   }
 };
+
+}  // namespace single_step_models
+using single_step_models::QuadraticObservationModel;
+using single_step_models::ScalarPolynomialModel;
+
+namespace {
+
+using Space = Kokkos::DefaultExecutionSpace;
+constexpr double dt = 0.01;
+constexpr double exact = 1e-13;  // relative: only rounding separates the bank from the formulas below
 
 struct OneStep {
   double m0, P0, dy, m, P;
@@ -248,7 +256,7 @@ OneStepN<Model> one_step_n(const Model& model, const std::string& name, const Op
 TEST(FilterSingleStep, PendulumUsesTheNonlinearObservation) {
   const PendulumModel model;
   const double g = model.g, q = model.q, r = model.r;
-  Mat<2, 2> ekf_P, ekf_ds_P, sof_P, sof_b_P;
+  Mat<2, 2> ekf_P = Mat<2, 2>::zero(), ekf_ds_P = ekf_P, sof_P = ekf_P, sof_b_P = ekf_P;
   for (const char* name : {"EKF", "EKF-DS", "SOF", "SOF-B"}) {
     const auto s = one_step_n(model, name);
     const std::string n = name;

@@ -258,7 +258,9 @@ TEST(ParticleFilterBank, TeamKernelResumsWhenTheWeightBoundIsFarOff) {
   // s - max l ~ 0.5 * 30^2 / 0.01 at the outlier's steps
   step_through_outliers(pb, pt, pp, 30.0, [&](int k) {
     expect_agree(pt, "step", k);
-    if (k == 1) EXPECT_LT(pt.effective_sample_size()(1), 0.1 * particles);  // the outlier did concentrate the weights
+    if (k == 1) {
+      EXPECT_LT(pt.effective_sample_size()(1), 0.1 * particles);  // the outlier did concentrate the weights
+    }
     if (k % 2 == 0) expect_agree(pp, "step_pair", k);
   });
 }

@@ -246,8 +246,9 @@ void check_chunked_against_team_path(int n, int members, const std::vector<int>&
     for (int s = 0; s < n; ++s) {
       const int a = resampled ? expected(s, m) : s;
       if (resampled && ancestors(s, m) != a) ++mismatches;
-      if (resampled)
+      if (resampled) {
         EXPECT_NE(l(a, m), -std::numeric_limits<double>::infinity()) << "dead particle drawn, member " << m;
+      }
       EXPECT_EQ(x_after(s, m, 0), x(a, m, 0));
       EXPECT_EQ(x_after(s, m, 1), x(a, m, 1));
       EXPECT_EQ(l_after(s, m), resampled ? 0.0 : l(s, m));

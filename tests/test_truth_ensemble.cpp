@@ -1,14 +1,13 @@
 // The bank of truths against exact moments: scalar OU, a 2-D linear model, and Clark's discrete-time model.
 // Statistical tests: fixed seed, M = 1e5 members, tolerance 4 standard errors, and a perturbed model that
 // the same test must reject (so the test can fail).
+#include "core/eigen_dense.hpp"
 #include "engine/truth_bank.hpp"
 #include "models/clark_linear_model.hpp"
 #include "models/linear_model.hpp"
 #include "models/ou_model.hpp"
 #include "models/sine_model.hpp"
 #include "tests/test_spaces.hpp"
-
-#include <Eigen/Dense>
 
 #include <cmath>
 

@@ -15,13 +15,12 @@
 // euler_lqr() is the exact minimum of the same discrete problem for a linear model: the discrete-time Riccati
 // recursion of the Euler scheme (x_{k+1} = (I + A dt) x_k + a0 dt + B dt u_k, stage cost dt [...]), which the direct
 // optimum must equal to rounding; the continuous LQR (riccati.hpp) differs from both by O(dt).
+#include "core/eigen_dense.hpp"
 #include "core/eigen_helpers.hpp"
 #include "core/errors.hpp"
 #include "engine/control/nominal_path.hpp"
 #include "kernels/control/quadratic_cost.hpp"
 #include "models/model_traits.hpp"
-
-#include <Eigen/Dense>
 
 #include <algorithm>
 #include <cmath>

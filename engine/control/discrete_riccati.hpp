@@ -8,11 +8,10 @@
 //   c_k = x*'Q x* + a'S a + 2 s'a - k'G k + c + tr(S W),
 // and the optimal feedback u = -(K x + k). With full state information this is optimal for any zero-mean
 // independent noise, Gaussian or not (the noise enters c only); with an estimate, it is the separation controller.
+#include "core/eigen_dense.hpp"
 #include "core/eigen_helpers.hpp"
 #include "core/errors.hpp"
 #include "engine/control/riccati.hpp"
-
-#include <Eigen/Dense>
 
 #include <cmath>
 #include <vector>

@@ -19,13 +19,12 @@
 // J* = E V(0, x0), x0 ~ N(x0_mean, x0_cov), by tensor Gauss-Hermite quadrature (20 points a dimension) of the
 // multilinear interpolant of V(0, .). The feedback u*(t, x) is kept at `table_rows` uniformly spaced times
 // (kernels/control/feedback_table.hpp).
+#include "core/eigen_dense.hpp"
 #include "core/eigen_helpers.hpp"
 #include "core/errors.hpp"
 #include "engine/control/gain_laws.hpp"
 #include "kernels/control/feedback_table.hpp"
 #include "kernels/control/quadratic_cost.hpp"
-
-#include <Eigen/Dense>
 
 #include <algorithm>
 #include <array>
@@ -259,7 +258,10 @@ HjbSolution<Model::state_dim> hjb_markov_chain(const Model& model,
             const double kink = -f[d] / B(d, 0);
             if (kink > -U && kink < U) kinks[count++] = kink;
           }
-        std::sort(kinks, kinks + count);
+        // At most n + 2 values: an insertion sort (std::sort's, beyond its 16-element threshold, is code GCC 12 warns
+        // about for an array this small).
+        for (int i = 1; i < count; ++i)
+          for (int j = i; j > 0 && kinks[j] < kinks[j - 1]; --j) std::swap(kinks[j], kinks[j - 1]);
         best_u = kinks[0];
         double best = g(best_u);
         for (int i = 0; i + 1 < count; ++i) {

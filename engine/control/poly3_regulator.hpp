@@ -43,14 +43,13 @@
 //          Jacobian, backtracking on |R|, to |R|_inf <= exact_tolerance.
 // A model without a power polynomial (the car: tan) supplies `design_polynomial(t)` (models/car_model.hpp): the law
 // is designed on it, as Basin does; `applied` is the schedule run on the model itself.
+#include "core/eigen_dense.hpp"
 #include "core/eigen_helpers.hpp"
 #include "core/errors.hpp"
 #include "engine/control/nominal_path.hpp"
 #include "kernels/control/gain_schedule.hpp"
 #include "kernels/control/quadratic_cost.hpp"
 #include "models/model_traits.hpp"
-
-#include <Eigen/Dense>
 
 #include <algorithm>
 #include <cmath>

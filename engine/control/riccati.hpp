@@ -8,12 +8,11 @@
 // and the optimal feedback u = -R^-1 B^T (S x + s) (Kwakernaak & Sivan 1972, ch. 3; SPEC section 5). Solved by
 // classical RK4 over each grid step, with the coefficients at the step's midpoint taken as the mean of its ends
 // (exact for time-invariant coefficients, second order for coefficients sampled on the grid).
+#include "core/eigen_dense.hpp"
 #include "core/eigen_helpers.hpp"
 #include "core/errors.hpp"
 #include "kernels/control/gain_schedule.hpp"
 #include "kernels/control/quadratic_cost.hpp"
-
-#include <Eigen/Dense>
 
 #include <cmath>
 #include <vector>

@@ -55,6 +55,9 @@ KOKKOS_INLINE_FUNCTION void load_particle_batch(const Real* xm, const Real* lwm,
       KUSHNER_DEVICE_UNROLL
       for (int i = 0; i < N; ++i) x[k][i] = xm[j + i * stride];
       lw[k] = Initialize ? 0.0 : lwm[j];
+    } else {  // past the end: never stepped, but defined (GCC cannot see that the step skips it too)
+      x[k] = Vec<N>::zero();
+      lw[k] = 0.0;
     }
   }
 }

@@ -13,6 +13,7 @@
 // and variance are c + s tanh c and s + s^2 sech^2 c; x_0 has posterior ∝ N(z; M_z, S_zz) cosh(c(z)) /
 // cosh(z), integrated by Gauss-Hermite quadrature. tests/test_particle_filter_references.cpp checks it against
 // the particle filter.
+#include "core/eigen_dense.hpp"
 #include "core/errors.hpp"
 #include "core/math.hpp"
 #include "core/status.hpp"
@@ -21,8 +22,6 @@
 #include "models/benes_model.hpp"
 
 #include <Kokkos_Core.hpp>
-
-#include <Eigen/Dense>
 
 #include <cmath>
 

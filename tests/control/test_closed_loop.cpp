@@ -1,12 +1,11 @@
 // The closed loop (engine/control/): LQG against its exact expected cost, ASRE@ASRE against LQG, and the
 // separation made explicit (a better estimator gives a lower cost under the same law).
+#include "core/eigen_dense.hpp"
 #include "engine/control/control_run.hpp"
 #include "engine/control/cost_reference.hpp"
 #include "models/model_list.hpp"
 
 #include <gtest/gtest.h>
-
-#include <Eigen/Dense>
 
 #include <cmath>
 #include <cstdio>

@@ -10,6 +10,7 @@
 // Table 3.1's smallest plant noise the moment filter in the loop estimates better than the Kalman filter.
 // Clark's specific optimal controller (ch. IV): LQR@MOM-SPEC's estimation error below the midpoint's, above the
 // moment filter's on the measurements (his Fig. 4.4: 40% below the midpoint's).
+#include "core/eigen_dense.hpp"
 #include "engine/control/control_run.hpp"
 #include "engine/control/perturbation_loop.hpp"
 #include "models/clark_linear_model.hpp"
@@ -17,8 +18,6 @@
 #include "models/linear_discrete_model.hpp"
 
 #include <gtest/gtest.h>
-
-#include <Eigen/Dense>
 
 #include <cmath>
 #include <cstdio>

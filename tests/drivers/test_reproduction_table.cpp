@@ -28,10 +28,18 @@ TEST(ReproductionTable, VerdictsFollowThePaperValue) {
   for (const PaperValue& v : paper_values("basin-car-filter"))
     if (v.key != "tan/KB/m_phi" && v.key != "tan/POLY3/m_phi") table.add(v.key, 1.0, 0.0, "r");
   for (const ReproductionRow& r : table.rows()) {
-    if (r.paper.key == "tan/KB/m_phi") EXPECT_EQ(r.verdict, reproduces);
-    if (r.paper.key == "tan/POLY3/m_phi") EXPECT_EQ(r.verdict, does_not_reproduce);
-    if (r.paper.key == "taylor/KB/delta") EXPECT_EQ(r.verdict, reproduces) << "1 against a printed 1";
-    if (r.paper.key == "taylor/EXACT/m_phi") EXPECT_EQ(r.verdict, no_number);
+    if (r.paper.key == "tan/KB/m_phi") {
+      EXPECT_EQ(r.verdict, reproduces);
+    }
+    if (r.paper.key == "tan/POLY3/m_phi") {
+      EXPECT_EQ(r.verdict, does_not_reproduce);
+    }
+    if (r.paper.key == "taylor/KB/delta") {
+      EXPECT_EQ(r.verdict, reproduces) << "1 against a printed 1";
+    }
+    if (r.paper.key == "taylor/EXACT/m_phi") {
+      EXPECT_EQ(r.verdict, no_number);
+    }
   }
   EXPECT_NE(table.text().find("tan truth (18): KB m_phi(20)"), std::string::npos);
   EXPECT_NE(table.csv("# c\n").find("tan/KB/m_phi,tan truth (18): KB m_phi(20),7.35,7.3410000000000002,0,reproduces"),

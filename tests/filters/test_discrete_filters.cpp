@@ -7,6 +7,7 @@
 //   filter (dimension 1 and 2) converges to KF on linear models faster than any power of its spacing, and the
 //   particle filter converges to it like N^-1/2 on nonlinear ones (model-file polynomials: a cubic transition,
 //   a square observation).
+#include "core/eigen_dense.hpp"
 #include "engine/filter_bank.hpp"
 #include "engine/particle_filter_bank.hpp"
 #include "kernels/reference/discrete_gaussian_grid_filter.hpp"
@@ -16,7 +17,6 @@
 #include "models/linear_discrete_model.hpp"
 
 #include <gtest/gtest.h>
-#include <Eigen/Dense>
 
 #include <cmath>
 #include <memory>
