@@ -84,14 +84,29 @@ std::unique_ptr<CLI::App> make_app(Options& o) {
   return app;
 }
 
+/// app.parse of `args` in their order (CLI11 consumes a reversed vector). Arguments no option takes are named in
+/// the order they were given: CLI11 2.3's own message joins them backwards ("3 --bogus" for `--bogus 3`).
+void parse_in_order(CLI::App& app, const std::vector<std::string>& args) {
+  std::vector<std::string> reversed(args.rbegin(), args.rend());
+  try {
+    app.parse(reversed);
+  } catch (const CLI::ExtrasError&) {
+    const std::vector<std::string> extra = app.remaining(true);
+    const auto subcommands = app.get_subcommands();
+    std::string joined;
+    for (const std::string& a : extra) joined += (joined.empty() ? "" : " ") + a;
+    throw InputError((extra.size() == 1 ? "unexpected argument: " : "unexpected arguments: ") + joined + " (`kushner " +
+                     (subcommands.empty() ? "" : subcommands[0]->get_name() + " ") + "--help` lists the options)");
+  }
+}
+
 /// Parses argv; when the chosen subcommand has --config FILE, parses again with the file's options placed
 /// before the command line's own (which therefore win). Returns nullptr after printing --help.
 std::unique_ptr<CLI::App> parse(int argc, char** argv, Options& o) {
   std::vector<std::string> args(argv + 1, argv + argc);
   auto app = make_app(o);
-  std::vector<std::string> reversed(args.rbegin(), args.rend());  // CLI11 consumes a reversed vector
   try {
-    app->parse(reversed);
+    parse_in_order(*app, args);
   } catch (const CLI::Success& e) {  // --help: printed by the app that parsed it, for the right subcommand
     app->exit(e);
     return nullptr;
@@ -108,8 +123,7 @@ std::unique_ptr<CLI::App> parse(int argc, char** argv, Options& o) {
   expanded.insert(expanded.end(), at + 1, args.end());
   o = Options{};
   app = make_app(o);
-  reversed.assign(expanded.rbegin(), expanded.rend());
-  app->parse(reversed);
+  parse_in_order(*app, expanded);
   return app;
 }
 

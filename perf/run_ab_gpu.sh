@@ -30,14 +30,24 @@ old_build=$here/build-cuda-ab-old
 [ -e "$old_src/.deps" ] || ln -s "$here/.deps" "$old_src/.deps"
 nvidia-smi --query-gpu=name,memory.total,power.limit,clocks.max.sm,driver_version --format=csv > "$out/gpu.csv" 2>&1
 
-# The libraries first, then every target in its own make at once: CMake's makefiles build the targets of one
-# call one after another, and each of these is one large nvcc translation unit (minutes, on one core).
+# One build per tree. With ninja (the GPU machine's image has it) all targets go to one `cmake --build` call: one
+# dependency graph, each target a large nvcc translation unit (minutes, on one core) built side by side. Without
+# it, CMake's makefiles build the targets of one call one after another (.NOTPARALLEL in the top Makefile), so the
+# libraries are built first and then every target in its own make at once; those makes each check the shared
+# libraries' dependencies, and of 7 targets started so on an H200 three failed while each built alone afterwards.
 build_tree() {  # build_tree SRC BUILD TARGETS...
   local src=$1 dir=$2; shift 2
-  local name; name=$(basename "$dir")
-  cmake -C "$here/perf/gpu_machine.cmake" -S "$src" -B "$dir" \
+  local name generator=()
+  name=$(basename "$dir")
+  command -v ninja >/dev/null && generator=(-G Ninja)
+  cmake "${generator[@]}" -C "$here/perf/gpu_machine.cmake" -S "$src" -B "$dir" \
     -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON -DKUSHNER_ENABLE_OPENMP=OFF \
     -DKUSHNER_CUDA_ARCH="$arch" ${KUSHNER_CMAKE_ARGS:-} > "$out/configure_$name.log" 2>&1 || return 1
+  if [ ${#generator[@]} -gt 0 ]; then
+    cmake --build "$dir" -j"$jobs" --target kushner_engine kushner_test_main kushner_bench_main "$@" \
+      > "$out/build_$name.log" 2>&1
+    return
+  fi
   cmake --build "$dir" -j"$jobs" --target kushner_engine kushner_test_main kushner_bench_main > "$out/build_$name.log" 2>&1 ||
     return 1
   local pids=() t rc=0
