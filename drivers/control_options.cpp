@@ -1,5 +1,7 @@
 #include "drivers/control_options.hpp"
 
+#include "drivers/whole_number_notation.hpp"
+
 #include <CLI/CLI.hpp>
 
 namespace kushner {
@@ -19,7 +21,8 @@ void add_control_options(CLI::App& app, ControlOptions& o) {
       ->check(CLI::IsMember({"auto", "hjb", "direct", "none"}))
       ->capture_default_str();
   app.add_option("--trace-member", o.trace_member, "member whose paths go to timeseries.csv and the plots")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->transform(whole_number_notation());
   app.add_flag("!--no-plots", o.plots, "write the CSV and JSON files only (no plots, no report.md)");
 }
 

@@ -1,6 +1,7 @@
 #include "drivers/filter_options.hpp"
 
 #include "core/errors.hpp"
+#include "drivers/whole_number_notation.hpp"
 #include "kernels/filters/filter_list.hpp"
 
 #include <CLI/CLI.hpp>
@@ -52,8 +53,11 @@ void add_filter_options(CLI::App& app, FilterOptions& o) {
         spec.help);
     option->default_str(std::visit([](const auto& v) { return value_text(v); }, spec.default_value));
     if (spec.kind == OptionSpec::Kind::choice) option->check(CLI::IsMember(spec.choices));
+    if (spec.kind == OptionSpec::Kind::integer) option->transform(whole_number_notation());
   }
-  app.add_option("--particles", o.particles, "particles per member of the particle filter (PF)")->capture_default_str();
+  app.add_option("--particles", o.particles, "particles per member of the particle filter (PF)")
+      ->capture_default_str()
+      ->transform(whole_number_notation());
   app.add_option("--resample", o.resample, "PF resampling scheme: systematic, stratified, multinomial, residual")
       ->capture_default_str();
   app.add_option("--ess-threshold", o.ess_threshold,
@@ -86,7 +90,8 @@ void add_compare_options(CLI::App& app, CompareOptions& o) {
   app.add_option("--trajectory-members", o.trajectory_members,
                  "members whose truth, estimates and bands go to trajectories.csv (comma-separated)")
       ->delimiter(',')
-      ->capture_default_str();
+      ->capture_default_str()
+      ->transform(whole_number_notation());
   app.add_option("--density-times", o.density_times,
                  "times of the density snapshots of x1 (comma-separated; default T/10, T/2, T)")
       ->delimiter(',');

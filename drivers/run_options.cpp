@@ -1,6 +1,7 @@
 #include "drivers/run_options.hpp"
 
 #include "core/errors.hpp"
+#include "drivers/whole_number_notation.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -19,17 +20,22 @@ void add_run_options(CLI::App& app, RunOptions& o) {
                  "a polynomial model from a TOML file instead of --model (README, \"Models\")");
   app.add_option("--set", o.sets, "model parameter, key=value (repeatable; matrices as 1,0;0,1)")
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
-  app.add_option("--members", o.members, "ensemble members M")->capture_default_str();
+  app.add_option("--members", o.members, "ensemble members M")
+      ->capture_default_str()
+      ->transform(whole_number_notation());
   app.add_option("--T", o.T, "time horizon (discrete-time models: the number of steps)")->capture_default_str();
   app.add_option("--dt", o.dt, "time step (discrete-time models: 1, the default for them)")
       ->capture_default_str()
       ->each([&o](const std::string&) { o.dt_given = true; });
-  app.add_option("--seed", o.seed, "random seed, 0 .. 4294967295")->capture_default_str();
+  app.add_option("--seed", o.seed, "random seed, 0 .. 4294967295")
+      ->capture_default_str()
+      ->transform(whole_number_notation());
   app.add_option("--out", o.out, "output directory (created if missing)")->capture_default_str();
   app.add_option("--output-points", o.output_points,
                  "N, for the time points of timeseries.csv: 0, every (T/dt / N)-th step (rounded down) and T, "
                  "so N + 1 where N divides T/dt (at most T/dt + 1; the default is capped there)")
       ->capture_default_str()
+      ->transform(whole_number_notation())
       ->each([&o](const std::string&) { o.output_points_given = true; });
   app.add_flag("--quiet", o.quiet, "no progress bar");
   app.add_option("--config", o.config, "read options from a TOML/INI file (keys: the long option names)");

@@ -28,6 +28,7 @@ expect_refused "--seed: must be in 0 .. 4294967295" simulate --seed -3 --out "$f
 expect_refused "prior_cov: not positive semidefinite (smallest eigenvalue -1)" simulate --set prior_cov=-1 --out "$fresh"
 expect_refused "model 'sine' has no parameter 'qq'" simulate --set qq=1 --out "$fresh"
 expect_refused "--members" simulate --members lots --out "$fresh"
+expect_refused "Could not convert: --members = 1.5" simulate --members 1.5 --out "$fresh"  # 1e3 is 1000
 # Named in the order given (CLI11 2.3's own message joined them backwards: "4 --b2 3 --bogus").
 expect_refused "unexpected arguments: --bogus 3 --b2 4 (\`kushner simulate --help\` lists the options)" \
   simulate --bogus 3 --b2 4 --out "$fresh"
