@@ -9,20 +9,24 @@
 
 namespace kushner {
 
-/// A CLI11 transform for the integer options (->transform(whole_number_notation())): a value with a decimal point
-/// or an exponent that is exactly a whole number of magnitude at most 2^53 becomes its digits; any other value is
-/// left as it is, for CLI11's integer conversion to take ("1000") or refuse ("1.5", "lots").
+/// A CLI11 transform for the integer options (->transform(whole_number_notation())): digits (with a sign) are left
+/// to CLI11's conversion, which also refuses what is out of the option's range; a value with a decimal point or an
+/// exponent that is exactly a whole number of magnitude at most 2^53 becomes its digits; anything else is refused as
+/// "--members: expected a whole number (got '1.5')".
 inline CLI::Validator whole_number_notation() {
   return CLI::Validator(
       [](std::string& value) {
-        if (value.find_first_of(".eE") == std::string::npos ||
-            value.find_first_not_of("0123456789+-.eE") != std::string::npos)
+        const std::size_t first_digit = (!value.empty() && (value[0] == '-' || value[0] == '+')) ? 1 : 0;
+        if (value.size() > first_digit && value.find_first_not_of("0123456789", first_digit) == std::string::npos)
           return std::string();
         char* end = nullptr;
         const double number = std::strtod(value.c_str(), &end);
-        if (end == value.c_str() + value.size() && std::fabs(number) <= 0x1p53 && number == std::floor(number))
+        if (!value.empty() && value.find_first_not_of("0123456789+-.eE") == std::string::npos &&
+            end == value.c_str() + value.size() && std::fabs(number) <= 0x1p53 && number == std::floor(number)) {
           value = std::to_string(static_cast<long long>(number));
-        return std::string();
+          return std::string();
+        }
+        return "expected a whole number (got '" + value + "')";
       },
       "");
 }
