@@ -11,8 +11,8 @@ namespace kushner {
 
 /// A CLI11 transform for the integer options (->transform(whole_number_notation())): digits (with a sign) are left
 /// to CLI11's conversion, which also refuses what is out of the option's range; a value with a decimal point or an
-/// exponent that is exactly a whole number of magnitude at most 2^53 becomes its digits; anything else is refused as
-/// "--members: expected a whole number (got '1.5')".
+/// exponent that is exactly a whole number of magnitude at most 2^53 becomes its digits (a larger one is refused as
+/// out of range); anything else is refused as "--members: expected a whole number (got '1.5')".
 inline CLI::Validator whole_number_notation() {
   return CLI::Validator(
       [](std::string& value) {
@@ -21,12 +21,12 @@ inline CLI::Validator whole_number_notation() {
           return std::string();
         char* end = nullptr;
         const double number = std::strtod(value.c_str(), &end);
-        if (!value.empty() && value.find_first_not_of("0123456789+-.eE") == std::string::npos &&
-            end == value.c_str() + value.size() && std::fabs(number) <= 0x1p53 && number == std::floor(number)) {
-          value = std::to_string(static_cast<long long>(number));
-          return std::string();
-        }
-        return "expected a whole number (got '" + value + "')";
+        const bool whole = !value.empty() && value.find_first_not_of("0123456789+-.eE") == std::string::npos &&
+                           end == value.c_str() + value.size() && number == std::floor(number);
+        if (!whole) return "expected a whole number (got '" + value + "')";
+        if (!(std::fabs(number) <= 0x1p53)) return "out of range (got '" + value + "')";
+        value = std::to_string(static_cast<long long>(number));
+        return std::string();
       },
       "");
 }

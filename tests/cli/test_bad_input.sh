@@ -29,7 +29,7 @@ expect_refused "prior_cov: not positive semidefinite (smallest eigenvalue -1)" s
 expect_refused "model 'sine' has no parameter 'qq'" simulate --set qq=1 --out "$fresh"
 expect_refused "--members: expected a whole number (got 'lots')" simulate --members lots --out "$fresh"
 expect_refused "--members: expected a whole number (got '1.5')" simulate --members 1.5 --out "$fresh"  # 1e3 is 1000
-expect_refused "--particles: expected a whole number (got '1e30')" filter --particles 1e30 --out "$fresh"
+expect_refused "--particles: out of range (got '1e30')" filter --particles 1e30 --out "$fresh"
 expect_refused "--trajectory-members: expected a whole number (got 'x')" compare --trajectory-members 0,x --out "$fresh"
 # Named in the order given (CLI11 2.3's own message joined them backwards: "4 --b2 3 --bogus").
 expect_refused "unexpected arguments: --bogus 3 --b2 4 (\`kushner simulate --help\` lists the options)" \
