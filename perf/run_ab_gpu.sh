@@ -37,19 +37,17 @@ nvidia-smi --query-gpu=name,memory.total,power.limit,clocks.max.sm,driver_versio
 # libraries' dependencies, and of 7 targets started so on an H200 three failed while each built alone afterwards.
 build_tree() {  # build_tree SRC BUILD TARGETS...
   local src=$1 dir=$2; shift 2
-  local name generator=()
+  local name generator=() libraries=(kushner_engine kushner_test_main kushner_bench_main)
   name=$(basename "$dir")
   command -v ninja >/dev/null && generator=(-G Ninja)
   cmake "${generator[@]}" -C "$here/perf/gpu_machine.cmake" -S "$src" -B "$dir" \
     -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON -DKUSHNER_ENABLE_OPENMP=OFF \
     -DKUSHNER_CUDA_ARCH="$arch" ${KUSHNER_CMAKE_ARGS:-} > "$out/configure_$name.log" 2>&1 || return 1
   if [ ${#generator[@]} -gt 0 ]; then
-    cmake --build "$dir" -j"$jobs" --target kushner_engine kushner_test_main kushner_bench_main "$@" \
-      > "$out/build_$name.log" 2>&1
+    cmake --build "$dir" -j"$jobs" --target "${libraries[@]}" "$@" > "$out/build_$name.log" 2>&1
     return
   fi
-  cmake --build "$dir" -j"$jobs" --target kushner_engine kushner_test_main kushner_bench_main > "$out/build_$name.log" 2>&1 ||
-    return 1
+  cmake --build "$dir" -j"$jobs" --target "${libraries[@]}" > "$out/build_$name.log" 2>&1 || return 1
   local pids=() t rc=0
   for t in "$@"; do
     cmake --build "$dir" -j2 --target "$t" > "$out/build_${name}_$t.log" 2>&1 &

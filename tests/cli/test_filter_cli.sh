@@ -55,6 +55,13 @@ assert all(math.isfinite(float(r["rmse_truth"])) for r in rows)
 PY
 echo "ok: summary.json and timeseries.csv"
 
+# A config file's counts as TOML floats (members = 2e1 reaches the command line as "20.0"): read as whole numbers.
+printf 'members = 2e1\nparticles = 6.4e1\nT = 0.05\ndt = 1e-2\n' >"$work/counts.toml"
+"$kushner" filter --model sine --filters EKF,PF --config "$work/counts.toml" --out "$work/counts" --quiet
+python3 -c 'import json, sys; s = json.load(open(sys.argv[1])); assert s["members"] == 20, s["members"]' \
+  "$work/counts/summary.json" || fail "members = 2e1 in a config file did not run 20 members"
+echo "ok: counts as TOML floats in --config"
+
 # "all" beside named references: every supported bank filter, PF, and EXACT; a bad name beside it still refused.
 "$kushner" filter --model sine --filters all,EXACT --members 20 --particles 64 --T 0.1 --dt 1e-2 --out "$work/all" --quiet
 "$kushner" filters --json >"$work/filters.json"
