@@ -20,6 +20,11 @@ namespace kushner {
 
 namespace detail {
 template <class Model, class = void>
+struct has_process_noise_columns : std::false_type {};
+template <class Model>
+struct has_process_noise_columns<Model, std::void_t<decltype(std::declval<const Model&>().process_noise_columns())>>
+    : std::true_type {};
+template <class Model, class = void>
 struct has_sine_observation_noise_option : std::false_type {};
 template <class Model>
 struct has_sine_observation_noise_option<
@@ -35,6 +40,18 @@ KOKKOS_INLINE_FUNCTION bool sine_observation_noise(const Model& model) {
     return model.observation_noise_is_sine();
   else
     return false;
+}
+
+/// The normals a continuous-time truth of `model` uses per step: its obs_dim observation normals and the process
+/// normals its diffusion has columns for; fewer than obs_dim + noise_dim where a model file's diffusion is padded with
+/// columns of zeros to its state dimension (PolynomialModel::process_noise_columns), so that it draws the numbers of
+/// the built-in model it writes out (truth_normals: which normal is drawn per member pair depends on the count).
+template <class Model>
+KOKKOS_INLINE_FUNCTION int truth_normal_count(const Model& model) {
+  if constexpr (detail::has_process_noise_columns<Model>::value)
+    return Model::obs_dim + model.process_noise_columns();
+  else
+    return Model::obs_dim + Model::noise_dim;
 }
 
 /// x(member) = mean + root z, z standard normal from Stream::truth_initial (root: any square root of the
@@ -73,9 +90,11 @@ KOKKOS_INLINE_FUNCTION void step_stored_state(const Truth& truth, const int memb
 /// member and step only, so every controller's loop sees the same noise (common random numbers); or
 /// dv = cos t - cos(t + dt) where the model's observation noise is the sine path (sine_observation_noise).
 /// A step's p observation and q process normals are one vector, v then w, of the process-noise stream
-/// (observation_and_process_normals): where p and q are both odd a Philox block and a Box-Muller pair serve the last
-/// of v and the first of w (the sine model: one block, one log and one square root per member-step instead of two
-/// each). v is drawn with sine observation noise too (and not used), so the state paths are the same for both.
+/// (truth_normals): where p and q are both odd a Philox block and a Box-Muller pair serve the last of v and the first
+/// of w (the sine model: one block, one log and one square root per member-step instead of two each), and where p + q
+/// is odd two neighbouring members share the block of the last normal (the cubic oscillator: 1.5 blocks per
+/// member-step instead of 2). v is drawn with sine observation noise too (and not used), so the state paths are the
+/// same for both.
 template <class Model, class MemSpace>
 struct EulerMaruyamaTruthStep {
   Model model;
@@ -102,7 +121,7 @@ struct EulerMaruyamaTruthStep {
     const auto who = static_cast<std::uint32_t>(member);
     Vec<p> zv;
     Vec<q> zw;
-    observation_and_process_normals<p, q>(key, who, 0, k, zv, zw);  // zv unused with sine observation noise
+    truth_normals<p, q>(key, who, k, truth_normal_count(model), zv, zw);  // zv unused with sine observation noise
     advance_state(at, u, xm, zw, zv, next, increment);
     store(dy, member, increment);
     store(x, member, next);
@@ -126,14 +145,28 @@ struct EulerMaruyamaTruthStep {
     next = xm + model.drift(at, xm, u) * dt + model.diffusion(at, xm) * dw;
   }
 
-  /// A member's normals on the host: observation_and_process_normals', in their layout.
+  /// A member's normals on the host: truth_normals', in their layout.
   using LaneLayout = ObservationAndProcessLayout<Model::obs_dim, Model::noise_dim>;
   static constexpr int lane_draws = LaneLayout::normals;
 
-  /// Host: the chunk's normals in SIMD lanes (draw_normal_lanes), z[k * host_lane_capacity + member - begin] for
-  /// normal k of lane_draws.
+  /// Host: the chunk's normals in SIMD lanes, truth_normals' numbers: z[k * host_lane_capacity + member - begin] for
+  /// normal k of lane_draws (draw_block_lanes, the last of an odd count draw_member_pair_normal_lanes; zero beyond
+  /// truth_normal_count).
   KUSHNER_FLATTEN void draw_lanes(const int begin, const int end, double* const z) const {
-    draw_lane_normals<lane_draws>(begin, end, RngKey{seed, Stream::process_noise}, z);
+    const RngKey key{seed, Stream::process_noise};
+    const std::uint32_t k = step;
+    const auto counter_of = [k](const int member, const int draw) {
+      return Counter{static_cast<std::uint32_t>(member), 0, k, static_cast<std::uint32_t>(draw)};
+    };
+    const int drawn = truth_normal_count(model);
+    for (int i = 0; i + 1 < drawn; i += 2)
+      draw_block_lanes(begin, end, key, counter_of, i / 2, z + i * host_lane_capacity,
+                       z + (i + 1) * host_lane_capacity);
+    if (drawn % 2 == 1)  // z's row holds host_lane_capacity (even) values: room for an odd chunk's last z1
+      draw_member_pair_normal_lanes(begin, end, key, k, static_cast<std::uint32_t>(drawn / 2),
+                                    z + (drawn - 1) * host_lane_capacity);
+    for (int i = drawn; i < lane_draws; ++i)
+      for (int member = begin; member < end; ++member) z[i * host_lane_capacity + member - begin] = 0.0;
   }
 
   /// Host: the members of one chunk in SIMD lanes (kernels/for_each_member.hpp's run_member_chunk): the draws
@@ -168,20 +201,6 @@ struct EulerMaruyamaTruthStep {
     for (int i = 0; i < p; ++i) dys[member + i * dy_stride] = ok ? increment[i] : dys[member + i * dy_stride];
     for (int i = 0; i < n; ++i) xs[member + i * x_stride] = ok ? next[i] : xm[i];
     return all_finite(next) && all_finite(increment);
-  }
-
- private:
-  /// N normals per member of the chunk from `key` into z[k * host_lane_capacity + member - begin]: normal_vector's
-  /// (blocks draw = 0 .. ceil(N/2) - 1 of (member, 0, step)).
-  template <int N>
-  void draw_lane_normals(const int begin, const int end, const RngKey& key, double* const z) const {
-    const std::uint32_t k = step;
-    draw_normal_lanes<N>(
-        begin, end, key,
-        [k](const int member, const int draw) {
-          return Counter{static_cast<std::uint32_t>(member), 0, k, static_cast<std::uint32_t>(draw)};
-        },
-        z, host_lane_capacity);
   }
 };
 

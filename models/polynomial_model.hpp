@@ -163,6 +163,9 @@ struct PolynomialModel : InitialLaw<N> {
   }
 
   KOKKOS_INLINE_FUNCTION Mat<N, N> diffusion(double, const Vec<N>&) const { return b; }
+  /// The columns of b that are the file's (q): a truth draws normals for these only (kernels/simulate_truth.hpp's
+  /// truth_normal_count), so that the file draws the numbers of the built-in model it writes out.
+  KOKKOS_INLINE_FUNCTION int process_noise_columns() const { return noise_columns; }
   KOKKOS_INLINE_FUNCTION Mat<N, N> observation_noise(double) const { return R; }
 
   // ---- the observation h, its derivatives and forms: the drift's formulas on the observation's coefficients --

@@ -94,6 +94,69 @@ TEST(ParticleDraws, OddCountOfLaneNormalsTakesTheLastBlocksCosineNormalBitForBit
   }
 }
 
+TEST(TruthNormals, AnOddCountsLastNormalIsSharedByAPairOfGlobalMembers) {
+  // truth_normals<2, 1> (the cubic oscillator's v, w): v from the member's block 0; w from block 1 of the pair's even
+  // global member, its z0 to the even member and its z1 to the odd one. A process whose first member is odd draws
+  // the numbers of the same global members; a padded layout (<2, 2>, a model file's) told that 3 are drawn, the same
+  // numbers and a zero for the fourth.
+  for (const std::uint32_t first : {0u, 1u, 256u, 0xffffffffu}) {
+    const RngKey key{Seed(20261130, first), Stream::process_noise};
+    for (std::uint32_t member = 0; member < 9; ++member) {
+      const std::uint32_t global = member + first;
+      const RngKey whole{Seed(20261130), Stream::process_noise};
+      Vec<2> v, v_padded;
+      Vec<1> w;
+      Vec<2> w_padded;
+      truth_normals<2, 1>(key, member, 7, 3, v, w);
+      truth_normals<2, 2>(key, member, 7, 3, v_padded, w_padded);
+      double a0, a1, b0, b1;
+      normal_pair(whole, Counter{global, 0, 7, 0}, a0, a1);
+      normal_pair(whole, Counter{global & ~1u, 0, 7, 1}, b0, b1);
+      EXPECT_EQ(v[0], a0) << first << " " << member;
+      EXPECT_EQ(v[1], a1);
+      EXPECT_EQ(w[0], (global & 1u) ? b1 : b0) << first << " " << member;
+      EXPECT_EQ(v_padded[0], v[0]);
+      EXPECT_EQ(v_padded[1], v[1]);
+      EXPECT_EQ(w_padded[0], w[0]);
+      EXPECT_EQ(w_padded[1], 0.0);
+    }
+  }
+  // An even count: every normal from the member's own blocks, as observation_and_process_normals draws them.
+  const RngKey key{3, Stream::process_noise};
+  Vec<1> v, v_own, w, w_own;
+  truth_normals<1, 1>(key, 5, 2, 2, v, w);
+  observation_and_process_normals<1, 1>(key, 5, 0, 2, v_own, w_own);
+  EXPECT_EQ(v[0], v_own[0]);
+  EXPECT_EQ(w[0], w_own[0]);
+}
+
+/// draw_member_pair_normal_lanes over lanes [begin, end) into z, compiled once (draw_lane_normals_apart's reason).
+KUSHNER_SAME_CODE_FOR_ALL_CALLERS void draw_pair_lanes_apart(const RngKey& key, const int begin, const int end,
+                                                             double* const z) {
+  draw_member_pair_normal_lanes(begin, end, key, 7, 1, z);
+}
+
+TEST(TruthNormals, MemberPairLanesDrawTheScalarNumbers) {
+  // The host's SIMD loop over member pairs against member_pair_normal, for chunks of either parity of length and of
+  // first global member (odd: its first normal drawn alone); the slot after an odd chunk is the only one written
+  // beyond it.
+  for (const std::uint32_t first : {0u, 1u}) {
+    const RngKey key{Seed(99, first), Stream::process_noise};
+    for (const int begin : {0, 1, 32, 33})
+      for (const int lanes : {1, 2, 7, 8, 31, 95, 96}) {
+        double z[lane_stride + 2];
+        std::fill(z, z + lane_stride + 2, -1.0);
+        draw_pair_lanes_apart(key, begin, begin + lanes, z);
+        for (int lane = 0; lane < lanes; ++lane) {
+          const double scalar = member_pair_normal(key, static_cast<std::uint32_t>(begin + lane), 7, 1);
+          ASSERT_NEAR(z[lane], scalar, 1e-15 * (1.0 + std::abs(scalar)))
+              << "first " << first << ", begin " << begin << ", " << lanes << " lanes, lane " << lane;
+        }
+        EXPECT_EQ(z[lanes + 1], -1.0) << "first " << first << ", begin " << begin << ", " << lanes << " lanes";
+      }
+  }
+}
+
 TEST(ParticleDraws, PairedNormalsAreUncorrelatedUnitNormals) {
   // 2^20 pairs: the even and odd particles' normals each have variance 1 and correlation 0, within 5 standard
   // errors (SE of a sample variance of normals sqrt(2 / n), of a correlation 1 / sqrt(n)); P(false alarm) ~ 1e-6.

@@ -51,27 +51,56 @@ inline double simd_normal_cosine(const RngKey key, const Counter c) {
   return box_muller_cosine_host(u0, u1);
 }
 
+/// Host: block `draw` of counter_of(lane, draw) for each lane of a SIMD loop over [begin, end), by simd_normal_pair:
+/// its z0 at z0s[lane - begin] and its z1 at z1s[lane - begin].
+template <class CounterOf>
+KUSHNER_FLATTEN void draw_block_lanes(const int begin, const int end, const RngKey& key, const CounterOf& counter_of,
+                                      const int draw, double* const z0s, double* const z1s) {
+  KUSHNER_SIMD
+  for (int lane = begin; lane < end; ++lane) {
+    const NormalPair pair = simd_normal_pair(key, counter_of(lane, draw));
+    z0s[lane - begin] = pair.z0;
+    z1s[lane - begin] = pair.z1;
+  }
+}
+
 /// Host: N normals for each lane of a SIMD loop over [begin, end), normal i of lane l at z[i * stride + l - begin]
 /// from block i / 2 of counter_of(l, i / 2) (so normal_vector's numbers where counter_of gives its counters), with
 /// glibc's vector log, sqrt, sin and cos. A loop of its own, with no model code in it, so that it vectorizes
 /// whatever the caller's step does: the draws are the same bits for every model, whether or not its step vectorizes
 /// (a model file's polynomial and the built-in model it equals give the same numbers). With N odd the last block's
-/// second normal is not wanted, and its sine is not computed (the cubic oscillator's truth step x1.1).
+/// second normal is not wanted, and its sine is not computed.
 template <int N, class CounterOf>
 KUSHNER_FLATTEN void draw_normal_lanes(const int begin, const int end, const RngKey& key, const CounterOf& counter_of,
                                        double* const z, const int stride) {
-  for (int i = 0; i + 1 < N; i += 2) {
-    KUSHNER_SIMD
-    for (int lane = begin; lane < end; ++lane) {
-      const NormalPair pair = simd_normal_pair(key, counter_of(lane, i / 2));
-      z[i * stride + lane - begin] = pair.z0;
-      z[(i + 1) * stride + lane - begin] = pair.z1;
-    }
-  }
+  for (int i = 0; i + 1 < N; i += 2)
+    draw_block_lanes(begin, end, key, counter_of, i / 2, z + i * stride, z + (i + 1) * stride);
   if constexpr (N % 2 == 1) {
     KUSHNER_SIMD
     for (int lane = begin; lane < end; ++lane)
       z[(N - 1) * stride + lane - begin] = simd_normal_cosine(key, counter_of(lane, N / 2));
+  }
+}
+
+/// Host: member_pair_normal(key, lane, step, draw) for each lane (local member) of [begin, end) into z[lane - begin]:
+/// one simd_normal_pair per member pair, in a SIMD loop over the pairs. Where end - begin is odd the last pair's z1
+/// goes to z[end - begin], which z must hold. A host chunk starts at a multiple of host_member_chunk and an MPI share
+/// at a multiple of moment_block_size (engine/member_share.hpp), so begin's global member is even and the pairs are
+/// whole; were it odd, its normal would be drawn alone first (the same number, possibly not the same last bit:
+/// glibc's scalar log against its vector one).
+KUSHNER_FLATTEN inline void draw_member_pair_normal_lanes(int begin, const int end, const RngKey& key,
+                                                          const std::uint32_t step, const std::uint32_t draw,
+                                                          double* z) {
+  if (begin < end && ((static_cast<std::uint32_t>(begin) + key.seed.first_member) & 1u) != 0) {
+    *z++ = member_pair_normal(key, static_cast<std::uint32_t>(begin), step, draw);
+    ++begin;
+  }
+  const int pairs = (end - begin + 1) / 2;
+  KUSHNER_SIMD
+  for (int j = 0; j < pairs; ++j) {
+    const NormalPair pair = simd_normal_pair(key, Counter{static_cast<std::uint32_t>(begin + 2 * j), 0, step, draw});
+    z[2 * j] = pair.z0;
+    z[2 * j + 1] = pair.z1;
   }
 }
 
