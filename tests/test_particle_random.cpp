@@ -1,7 +1,7 @@
 // The host particle kernel's vectorizable Philox (kernels/particle_filter/simd_random.hpp) against Random123's
 // (kernels/rng.hpp, used on the GPU): the same uniforms bit for bit, the same normals to the last bits of the
-// math library; and the particle pairs' draws (kernels/particle_filter/particle_draws.hpp), in fp64 and in the
-// `mixed` precision's fp32.
+// math library; the particle pairs' draws (kernels/particle_filter/particle_draws.hpp), in fp64 and in the
+// `mixed` precision's fp32; and the truths' member pairs (an odd count's last normal: truth_normals).
 #include "kernels/for_each_member.hpp"
 #include "kernels/particle_filter/particle_draws.hpp"
 
