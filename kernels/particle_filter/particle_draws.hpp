@@ -51,8 +51,11 @@ inline double simd_normal_cosine(const RngKey key, const Counter c) {
   return box_muller_cosine_host(u0, u1);
 }
 
-/// Host: block `draw` of counter_of(lane, draw) for each lane of a SIMD loop over [begin, end), by simd_normal_pair:
-/// its z0 at z0s[lane - begin] and its z1 at z1s[lane - begin].
+/// Host: block `draw` of counter_of(lane, draw) for each lane of a SIMD loop over [begin, end), by simd_normal_pair
+/// (glibc's vector log, sqrt, sin and cos): its z0 at z0s[lane - begin] and its z1 at z1s[lane - begin]. A loop of its
+/// own, with no model code in it, so that it vectorizes whatever the caller's step does: the draws are the same bits
+/// for every model, whether or not its step vectorizes (a model file's polynomial and the built-in model it equals
+/// give the same numbers). The truths' draws (EulerMaruyamaTruthStep::draw_lanes) and draw_normal_lanes use it.
 template <class CounterOf>
 KUSHNER_FLATTEN void draw_block_lanes(const int begin, const int end, const RngKey& key, const CounterOf& counter_of,
                                       const int draw, double* const z0s, double* const z1s) {
@@ -65,11 +68,9 @@ KUSHNER_FLATTEN void draw_block_lanes(const int begin, const int end, const RngK
 }
 
 /// Host: N normals for each lane of a SIMD loop over [begin, end), normal i of lane l at z[i * stride + l - begin]
-/// from block i / 2 of counter_of(l, i / 2) (so normal_vector's numbers where counter_of gives its counters), with
-/// glibc's vector log, sqrt, sin and cos. A loop of its own, with no model code in it, so that it vectorizes
-/// whatever the caller's step does: the draws are the same bits for every model, whether or not its step vectorizes
-/// (a model file's polynomial and the built-in model it equals give the same numbers). With N odd the last block's
-/// second normal is not wanted, and its sine is not computed.
+/// from block i / 2 of counter_of(l, i / 2) (so normal_vector's numbers where counter_of gives its counters; the
+/// EnKBF's ensemble members draw so), in draw_block_lanes' loops. With N odd the last block's second normal is not
+/// wanted, and its sine is not computed.
 template <int N, class CounterOf>
 KUSHNER_FLATTEN void draw_normal_lanes(const int begin, const int end, const RngKey& key, const CounterOf& counter_of,
                                        double* const z, const int stride) {
