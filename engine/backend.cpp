@@ -36,6 +36,15 @@ void require_usable_gpu() {
 #endif
 }
 
+/// The GPU this process runs on: its local rank's, round robin over the node's GPUs (two ranks may share one).
+int rank_gpu() {
+  int devices = 1;
+#if defined(KOKKOS_ENABLE_CUDA)
+  if (cudaGetDeviceCount(&devices) != cudaSuccess || devices < 1) devices = 1;
+#endif
+  return local_rank() % devices;
+}
+
 }  // namespace
 
 std::vector<std::string> available_backends() {
@@ -84,8 +93,12 @@ BackendDescription describe_backend(const std::string& name) {
 std::optional<double> available_memory_bytes(const std::string& name) {
 #if defined(KOKKOS_ENABLE_CUDA)
   if (name == "cuda") {
+    // The memory check runs before Kokkos starts: without choosing the rank's GPU first, every rank asked GPU 0 (the
+    // runtime's default), and a rank of another GPU read GPU 0's free memory and opened a context there (the
+    // memory and start-up time of a second context, and a share of GPU 0 under its neighbour).
     std::size_t free_bytes = 0, total_bytes = 0;
-    if (cudaMemGetInfo(&free_bytes, &total_bytes) != cudaSuccess) return std::nullopt;
+    if (cudaSetDevice(rank_gpu()) != cudaSuccess || cudaMemGetInfo(&free_bytes, &total_bytes) != cudaSuccess)
+      return std::nullopt;
     return static_cast<double>(free_bytes);
   }
 #endif
@@ -134,11 +147,7 @@ KokkosSession::KokkosSession(const std::string& backend) {
     // Ranks on one node share it: each takes the GPU of its local rank (round robin when there are fewer GPUs,
     // e.g. two ranks on one GPU), and, when mpirun left it unbound and OMP_NUM_THREADS is unset, its share of
     // the cores (a rank bound to cores gets as many threads as it has cores from OpenMP itself).
-    int devices = 1;
-#if defined(KOKKOS_ENABLE_CUDA)
-    if (cudaGetDeviceCount(&devices) != cudaSuccess || devices < 1) devices = 1;
-#endif
-    args.push_back("--kokkos-device-id=" + std::to_string(local_rank() % devices));
+    args.push_back("--kokkos-device-id=" + std::to_string(rank_gpu()));
     cpu_set_t mask;
     const unsigned hardware = std::thread::hardware_concurrency();
     const bool unbound =
