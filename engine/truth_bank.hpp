@@ -40,6 +40,12 @@ class TruthBank {
     simulate_truth_step(space_, model_, x_, observations_, k * dt, dt, seed_, static_cast<std::uint32_t>(k));
   }
 
+  /// step(k, dt), then ensemble_moments(state()) (a collective call), on the host in one pass.
+  EnsembleMoments step_and_moments(long k, double dt) {
+    return simulate_truth_step_and_moments(space_, model_, x_, observations_, k * dt, dt, seed_,
+                                           static_cast<std::uint32_t>(k));
+  }
+
   const BankVector<MemSpace>& state() const { return x_; }
   const BankVector<MemSpace>& observations() const { return observations_; }
 
@@ -57,16 +63,22 @@ MomentSeries simulate_ensemble(const ExecSpace& space, const Model& model, long 
   TruthBank<ExecSpace, Model> bank(space, model, share.count, share.seed(seed));
   MomentSeries series;
   std::size_t next_output = 0;
-  space.fence();
-  const auto loop_start = std::chrono::steady_clock::now();
-  for (long k = 0;; ++k) {
-    if (next_output < grid.output_steps.size() && grid.output_steps[next_output] == k) {
+  const auto output_at = [&](const long k) {
+    const bool output = next_output < grid.output_steps.size() && grid.output_steps[next_output] == k;
+    if (output) {
       series.times.push_back(k * grid.dt);
-      series.moments.push_back(ensemble_moments(space, bank.state()));
       ++next_output;
     }
-    if (k == grid.steps) break;
-    bank.step(k, grid.dt);
+    return output;
+  };
+  space.fence();
+  const auto loop_start = std::chrono::steady_clock::now();
+  if (output_at(0)) series.moments.push_back(ensemble_moments(space, bank.state()));
+  for (long k = 0; k < grid.steps; ++k) {
+    if (output_at(k + 1))  // the moments of the state step k leaves
+      series.moments.push_back(bank.step_and_moments(k, grid.dt));
+    else
+      bank.step(k, grid.dt);
     if (progress) progress(k + 1);
   }
   space.fence();

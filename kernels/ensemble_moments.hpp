@@ -641,6 +641,23 @@ void merge_block_rows(const ExecSpace& space, const MergeBlockRows<typename Exec
     Kokkos::parallel_for("kushner::merge_block_rows", Kokkos::RangePolicy<ExecSpace>(space, 0, pairs), merge);
 }
 
+/// ensemble_moments of a bank's `columns` columns from its block rows (host rows, BlockStatistics' layout: `size`
+/// doubles, 3 columns per row, FiniteRowValue's values) over its `members` members, merged over every rank (a
+/// collective call).
+inline EnsembleMoments moments_of_block_rows(const double* rows, const std::size_t size, const int columns,
+                                             const long members) {
+  const std::vector<EnsembleMoments> per_column = merge_block_statistics(rows, size, columns, 0, members).moments;
+  // Every rank has the same columns, so every rank takes the same branch of this collective call.
+  const long all_members = per_column.empty() ? collective::sum(members) : per_column.front().members;
+  EnsembleMoments result{{}, {}, all_members, all_members};
+  for (const auto& mo : per_column) {
+    result.mean.push_back(mo.mean[0]);
+    result.variance.push_back(mo.variance[0]);
+    result.non_finite = mo.non_finite;  // the same in every column
+  }
+  return result;
+}
+
 /// Mean and sample variance of every column of x(member, column) over members.
 template <class ExecSpace, class View>
 EnsembleMoments ensemble_moments(const ExecSpace& space, const View& x) {
@@ -666,17 +683,7 @@ EnsembleMoments ensemble_moments(const ExecSpace& space, const View& x) {
   }
   space.fence();
   const auto rows = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), blocks);
-  const std::vector<EnsembleMoments> per_column =
-      merge_block_statistics(rows.data(), rows.size(), columns, 0, members).moments;
-  // Every rank has the same columns, so every rank takes the same branch of this collective call.
-  const long all_members = per_column.empty() ? collective::sum(members) : per_column.front().members;
-  EnsembleMoments result{{}, {}, all_members, all_members};
-  for (const auto& mo : per_column) {
-    result.mean.push_back(mo.mean[0]);
-    result.variance.push_back(mo.variance[0]);
-    result.non_finite = mo.non_finite;  // the same in every column
-  }
-  return result;
+  return moments_of_block_rows(rows.data(), rows.size(), columns, members);
 }
 
 }  // namespace kushner

@@ -5,6 +5,7 @@
 #include "core/errors.hpp"
 #include "core/linear_algebra.hpp"
 #include "kernels/bank.hpp"
+#include "kernels/ensemble_moments.hpp"
 #include "kernels/for_each_member.hpp"
 #include "kernels/particle_filter/particle_draws.hpp"
 #include "kernels/rng.hpp"
@@ -258,18 +259,97 @@ template <class Model, class MemSpace>
 using TruthStep = std::conditional_t<Model::discrete_time, DiscreteTruthStep<Model, MemSpace>,
                                      EulerMaruyamaTruthStep<Model, MemSpace>>;
 
+/// The banks a truth step of Model takes: x (members, state_dim) and its observations (members, obs_dim).
+template <class Model, class MemSpace>
+void require_truth_banks(const BankVector<MemSpace>& x, const BankVector<MemSpace>& observations) {
+  KUSHNER_REQUIRE(x.extent_int(1) == Model::state_dim,
+                  "x has " << x.extent(1) << " columns, " << Model::name << " has state_dim " << Model::state_dim);
+  KUSHNER_REQUIRE(observations.extent_int(1) == Model::obs_dim && observations.extent(0) == x.extent(0),
+                  "observation bank has shape (" << observations.extent(0) << ", " << observations.extent(1) << ")");
+}
+
+/// Fewest members for which a host truth step goes by blocks of moment_block_size members (TruthStepBlocks) rather than
+/// by parallel_for_members' chunks of host_member_chunk: below it the blocks are too few to share among a host's
+/// threads (engine/filter_run.hpp's segments start at the same count).
+constexpr long truth_block_min_members = 16 * moment_block_size;
+
+/// A host truth step by blocks of moment_block_size members, each in runs of host_lane_capacity (run_member_runs: the
+/// truth's chunk function sets itself up once per 128 members instead of once per 32; the same bits), and, given
+/// `blocks`, the moments of the state it leaves: each column's block_statistic of FiniteRowValue, as
+/// ensemble_moments' one-thread form takes it (the same bits), by the thread that just wrote the block, while it is in
+/// that core's cache.
+template <class Step, class View, int Columns>
+struct TruthStepBlocks {
+  Step step;
+  View x;
+  int members;
+  BlockStatistics<Kokkos::HostSpace> blocks;  // (block, 3 Columns), or none: no moments
+
+  void operator()(const int b) const {
+    const int begin = b * moment_block_size, end = block_end(b, members);
+    run_member_runs(step, begin, end);
+    if (blocks.extent(0) == 0) return;
+    for (int c = 0; c < Columns; ++c)
+      store_block_statistic(blocks, Columns, b, c, block_statistic(FiniteRowValue<View, Columns>{x, c}, begin, end));
+  }
+};
+
+/// Whether a truth step of these banks goes by blocks (TruthStepBlocks).
+template <class MemSpace>
+bool truth_step_by_blocks(const BankVector<MemSpace>& x) {
+  return std::is_same<MemSpace, Kokkos::HostSpace>::value && static_cast<long>(x.extent(0)) >= truth_block_min_members;
+}
+
+/// TruthStepBlocks over every block of x; `blocks`: none, or (blocks of x, 3 state_dim) for the moments.
+template <class ExecSpace, class Model>
+void step_truth_blocks(const ExecSpace& space, const Model& model, const BankVector<Kokkos::HostSpace>& x,
+                       const BankVector<Kokkos::HostSpace>& observations, double t, double dt, Seed seed,
+                       std::uint32_t step, const BlockStatistics<Kokkos::HostSpace>& blocks) {
+  const int members = x.extent_int(0);
+  Kokkos::parallel_for(
+      "kushner::truth_step_blocks", Kokkos::RangePolicy<ExecSpace>(space, 0, static_cast<int>(moment_blocks(members))),
+      TruthStepBlocks<TruthStep<Model, Kokkos::HostSpace>, BankVector<Kokkos::HostSpace>, Model::state_dim>{
+          {model, x, observations, t, dt, seed, step}, x, members, blocks});
+}
+
 /// Advances every member of the bank by one step; `observations` receives dy (continuous time) or z[k+1]
 /// (discrete time). No fence: the caller fences before reading results on the host.
 template <class ExecSpace, class Model, class MemSpace>
 void simulate_truth_step(const ExecSpace& space, const Model& model, const BankVector<MemSpace>& x,
                          const BankVector<MemSpace>& observations, double t, double dt, Seed seed, std::uint32_t step) {
   static_assert(Kokkos::SpaceAccessibility<ExecSpace, MemSpace>::accessible, "bank not accessible from ExecSpace");
-  KUSHNER_REQUIRE(x.extent_int(1) == Model::state_dim,
-                  "x has " << x.extent(1) << " columns, " << Model::name << " has state_dim " << Model::state_dim);
-  KUSHNER_REQUIRE(observations.extent_int(1) == Model::obs_dim && observations.extent(0) == x.extent(0),
-                  "observation bank has shape (" << observations.extent(0) << ", " << observations.extent(1) << ")");
+  require_truth_banks<Model>(x, observations);
+  if constexpr (std::is_same<MemSpace, Kokkos::HostSpace>::value) {
+    if (truth_step_by_blocks(x)) {
+      step_truth_blocks(space, model, x, observations, t, dt, seed, step, {});
+      return;
+    }
+  }
   parallel_for_members("kushner::truth_step", space, x.extent(0),
                        TruthStep<Model, MemSpace>{model, x, observations, t, dt, seed, step});
+}
+
+/// simulate_truth_step, then ensemble_moments of the state it leaves (the same bits; over every rank: a collective
+/// call). By blocks on the host (TruthStepBlocks) in one pass: a reduction of its own read the whole state back from
+/// memory, as much as a tenth of the cubic oscillator's step at 1e6 members (x and dy 32 MB, more than the caches
+/// hold; perf/filter_bank.md). On a GPU, or with few members, the two in turn.
+template <class ExecSpace, class Model, class MemSpace>
+EnsembleMoments simulate_truth_step_and_moments(const ExecSpace& space, const Model& model,
+                                                const BankVector<MemSpace>& x, const BankVector<MemSpace>& observations,
+                                                double t, double dt, Seed seed, std::uint32_t step) {
+  if constexpr (std::is_same<MemSpace, Kokkos::HostSpace>::value) {
+    if (truth_step_by_blocks(x)) {
+      require_truth_banks<Model>(x, observations);
+      const int members = x.extent_int(0);
+      BlockStatistics<MemSpace> blocks(Kokkos::view_alloc(Kokkos::WithoutInitializing, "kushner::moment_blocks"),
+                                       moment_blocks(members), 3 * Model::state_dim);
+      step_truth_blocks(space, model, x, observations, t, dt, seed, step, blocks);
+      space.fence();
+      return moments_of_block_rows(blocks.data(), blocks.size(), Model::state_dim, members);
+    }
+  }
+  simulate_truth_step(space, model, x, observations, t, dt, seed, step);
+  return ensemble_moments(space, x);
 }
 
 }  // namespace kushner

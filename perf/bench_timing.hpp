@@ -9,23 +9,20 @@
 
 namespace kushner {
 
-/// What time_truth_steps does after each step by default: nothing.
-struct NothingAfterStep {
-  void operator()() const {}
-};
-
-/// Steps `bank` once per iteration (what `kushner simulate` does per step), then calls after_step() inside the timing
-/// (an output step's moments): member_steps_per_s.
-template <class Space, class Model, class AfterStep = NothingAfterStep>
-void time_truth_steps(benchmark::State& state, TruthBank<Space, Model>& bank, const AfterStep& after_step = {}) {
+/// Steps `bank` once per iteration (what `kushner simulate` does per step; with `moments`, what it does per output
+/// step: TruthBank::step_and_moments): member_steps_per_s.
+template <class Space, class Model>
+void time_truth_steps(benchmark::State& state, TruthBank<Space, Model>& bank, const bool moments = false) {
   const auto members = static_cast<double>(bank.state().extent(0));
   const Space space;
   long k = 0;
   for (auto _ : state) {
     space.fence();
     Kokkos::Timer timer;
-    bank.step(k++, 1e-3);
-    after_step();
+    if (moments)
+      benchmark::DoNotOptimize(bank.step_and_moments(k++, 1e-3).mean);
+    else
+      bank.step(k++, 1e-3);
     space.fence();
     state.SetIterationTime(timer.seconds());
   }

@@ -48,7 +48,9 @@ for rep in $(seq "$reps"); do
     for model in sine cubic-oscillator cubic-sensor; do
       s=$(seconds "$kushner" simulate --model $model --members "$members" --T $T --dt $dt --seed $rep --quiet \
             --out "$work/sim-$model-$T")
-      echo "truth-$model $rep $T $s nan" >> "$work/times"
+      loop=$("$python" -c 'import json,sys; print(json.load(open(sys.argv[1]))["timing"]["step_loop_s"])' \
+               "$work/sim-$model-$T/summary.json" 2>/dev/null || echo nan)
+      echo "truth-$model $rep $T $s $loop" >> "$work/times"
     done
   done
   OMP_NUM_THREADS=1 "$python" "$here/perf/bank_numpy.py" --members "$members" --T $T_long --rate $T_short --dt $dt \
@@ -65,8 +67,8 @@ runs = {}
 for line in open(work + "/times"):
     what, rep, T, s, loop = line.split()
     runs.setdefault(what, {}).setdefault(int(rep), {})[float(T)] = (float(s), float(loop))
-def rates(what):
-    return [members * steps / (r[T_long][0] - r[T_short][0]) for r in runs[what].values()]
+def rates(what, i=0):  # i = 0: whole commands' wall times; 1: summary.json's step_loop_s
+    return [members * steps / (r[T_long][i] - r[T_short][i]) for r in runs[what].values()]
 def med(xs):
     return statistics.median(xs)
 def show(label, xs):
@@ -77,8 +79,7 @@ for rep, r in sorted(runs["bank"].items()):
     print(f"  kushner filter rep {rep}: T={T_long}: {r[T_long][0]:.3f} s (step loop {r[T_long][1]:.3f} s), "
           f"T={T_short}: {r[T_short][0]:.3f} s (step loop {r[T_short][1]:.3f} s)")
 show("kushner filter sine EKF,SOF,QLF,KBL (CLI)", bank)
-loop_rates = [members * steps / (r[T_long][1] - r[T_short][1]) for r in runs["bank"].values()]
-show("  the same from summary.json's step_loop_s", loop_rates)
+show("  the same from summary.json's step_loop_s", rates("bank", 1))
 numpy = [json.load(open(f)) for f in sorted(glob.glob(work + "/numpy-*.json"))]
 np_rates = [n["member_steps_per_s"][0] for n in numpy]
 for n in numpy:
@@ -86,10 +87,13 @@ for n in numpy:
 show(f"NumPy {numpy[0]['numpy']} bank (1 core)", np_rates)
 print(f"kushner / NumPy = {med(bank) / med(np_rates):.3g}x (medians)")
 truth = {m: rates("truth-" + m) for m in ("sine", "cubic-oscillator", "cubic-sensor")}
+truth_loops = {m: rates("truth-" + m, 1) for m in truth}
 for m, xs in truth.items():
     show(f"kushner simulate {m} (truth step)", xs)
+    show("  the same from summary.json's step_loop_s", truth_loops[m])
 for m in ("cubic-oscillator", "cubic-sensor"):
-    print(f"truth step per member-step, {m} / sine = {med(truth['sine']) / med(truth[m]):.3g}x the time")
+    print(f"truth step per member-step, {m} / sine = {med(truth['sine']) / med(truth[m]):.3g}x the time "
+          f"(step loops: {med(truth_loops['sine']) / med(truth_loops[m]):.3g}x)")
 copy = json.load(open(work + "/copy.json"))
 # Bytes per member-step of the bank: truth x (r+w), dy (w, then r); per filter m, P (r+w each), status (r),
 # the score sums (squared error, nees, nees points: r+w), the snapshot at output steps (2 doubles, w).

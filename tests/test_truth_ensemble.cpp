@@ -1,15 +1,18 @@
 // The bank of truths against exact moments: scalar OU, a 2-D linear model, and Clark's discrete-time model.
 // Statistical tests: fixed seed, M = 1e5 members, tolerance 4 standard errors, and a perturbed model that
-// the same test must reject (so the test can fail).
+// the same test must reject (so the test can fail). And the host's truth steps by blocks, with an output step's
+// moments in the same pass, against the chunks of one member kernel and ensemble_moments, bit for bit.
 #include "core/eigen_dense.hpp"
 #include "engine/truth_bank.hpp"
 #include "models/clark_linear_model.hpp"
+#include "models/cubic_oscillator_model.hpp"
 #include "models/linear_model.hpp"
 #include "models/ou_model.hpp"
 #include "models/sine_model.hpp"
 #include "tests/test_spaces.hpp"
 
 #include <cmath>
+#include <limits>
 
 namespace kushner {
 namespace {
@@ -164,6 +167,63 @@ TEST(EulerMaruyamaStep, SineStepMatchesHandComputation) {
     const double dx_noise = 0.7 * dw * std::sqrt(dt), dy_noise = 0.3 * dv * std::sqrt(dt);
     EXPECT_NEAR(x1(m, 0), x - std::sin(x) * dt + dx_noise, 1e-13 * (std::abs(x) + std::abs(dx_noise)));
     EXPECT_NEAR(dy(m, 0), x * dt + dy_noise, 1e-13 * (std::abs(x * dt) + std::abs(dy_noise)));
+  }
+}
+
+/// TruthBank's steps (by blocks from truth_block_min_members on the host) and step_and_moments (in one pass there)
+/// against a twin bank stepped by parallel_for_members' chunks, with ensemble_moments after each step: the same states
+/// and the same moments, bit for bit, over whole blocks and a short one, with a member that escaped (left out of every
+/// column by both).
+template <class Space, class Model>
+void expect_truth_steps_to_be_chunks_then_moments(const Model& model, const long members) {
+  using MemSpace = typename Space::memory_space;
+  TruthBank<Space, Model> bank(Space(), model, members, seed), chunks(Space(), model, members, seed);
+  for (auto* b : {&bank, &chunks}) {
+    auto x = b->state();
+    const auto host = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), x);
+    host(300, Model::state_dim - 1) = std::numeric_limits<double>::infinity();
+    Kokkos::deep_copy(x, host);
+  }
+  const double dt = 1e-2;
+  for (long k = 0; k < 4; ++k) {
+    parallel_for_members("chunks", Space(), members,
+                         TruthStep<Model, MemSpace>{model, chunks.state(), chunks.observations(), k * dt, dt,
+                                                    Seed{seed}, static_cast<std::uint32_t>(k)});
+    const EnsembleMoments expected = ensemble_moments(Space(), chunks.state());
+    if (k % 2 == 1) {
+      bank.step(k, dt);
+      continue;
+    }
+    const EnsembleMoments a = bank.step_and_moments(k, dt);
+    EXPECT_EQ(a.mean, expected.mean) << Model::name << ", " << members << " members, step " << k;
+    EXPECT_EQ(a.variance, expected.variance) << Model::name << ", " << members << " members, step " << k;
+    EXPECT_EQ(a.non_finite, 1) << Model::name << ", " << members << " members, step " << k;
+    EXPECT_EQ(expected.non_finite, 1) << Model::name << ", " << members << " members, step " << k;
+    EXPECT_EQ(a.members, members);
+  }
+  const auto xa = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bank.state());
+  const auto xb = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), chunks.state());
+  const auto ya = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bank.observations());
+  const auto yb = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), chunks.observations());
+  int differ = 0;
+  for (long m = 0; m < members; ++m) {
+    for (int i = 0; i < Model::state_dim; ++i)
+      differ += !(xa(m, i) == xb(m, i) || (std::isnan(xa(m, i)) && std::isnan(xb(m, i))));
+    for (int i = 0; i < Model::obs_dim; ++i)
+      differ += !(ya(m, i) == yb(m, i) || (std::isnan(ya(m, i)) && std::isnan(yb(m, i))));
+  }
+  EXPECT_EQ(differ, 0) << Model::name << ", " << members << " members";
+}
+
+template <class Space>
+class StepAndMoments : public ::testing::Test {};
+TYPED_TEST_SUITE(StepAndMoments, test::ExecutionSpaces);
+
+TYPED_TEST(StepAndMoments, AreChunkStepsThenEnsembleMomentsBitForBit) {
+  for (const long members : {3L * moment_block_size + 37, truth_block_min_members + 37}) {  // chunks; blocks
+    expect_truth_steps_to_be_chunks_then_moments<TypeParam>(SineModel{}, members);
+    expect_truth_steps_to_be_chunks_then_moments<TypeParam>(CubicOscillatorModel{}, members);
+    expect_truth_steps_to_be_chunks_then_moments<TypeParam>(ClarkLinearModel{}, members);
   }
 }
 
