@@ -40,7 +40,8 @@ class TruthBank {
     simulate_truth_step(space_, model_, x_, observations_, k * dt, dt, seed_, static_cast<std::uint32_t>(k));
   }
 
-  /// step(k, dt), then ensemble_moments(state()) (a collective call), on the host in one pass.
+  /// step(k, dt), then ensemble_moments(state()) (a collective call); in one pass on the host from
+  /// truth_block_min_members members (simulate_truth_step_and_moments).
   EnsembleMoments step_and_moments(long k, double dt) {
     return simulate_truth_step_and_moments(space_, model_, x_, observations_, k * dt, dt, seed_,
                                            static_cast<std::uint32_t>(k));
