@@ -294,10 +294,9 @@ struct TruthStepBlocks {
   }
 };
 
-/// Whether a truth step of these banks goes by blocks (TruthStepBlocks).
-template <class MemSpace>
-bool truth_step_by_blocks(const BankVector<MemSpace>& x) {
-  return std::is_same<MemSpace, Kokkos::HostSpace>::value && static_cast<long>(x.extent(0)) >= truth_block_min_members;
+/// Whether a host truth step of bank x goes by blocks (TruthStepBlocks).
+inline bool truth_step_by_blocks(const BankVector<Kokkos::HostSpace>& x) {
+  return static_cast<long>(x.extent(0)) >= truth_block_min_members;
 }
 
 /// TruthStepBlocks over every block of x; `blocks`: none, or (blocks of x, 3 state_dim) for the moments.

@@ -13,13 +13,13 @@
 #include "models/cubic_sensor_model.hpp"
 #include "models/linear_discrete_model.hpp"
 #include "models/sine_model.hpp"
+#include "tests/filter_test_helpers.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -27,18 +27,12 @@
 namespace kushner {
 namespace {
 
+using test::same_bits;
+
 using Space = Kokkos::DefaultHostExecutionSpace;
 using MemSpace = Space::memory_space;
 using DeviceSpace = Kokkos::DefaultExecutionSpace;
 constexpr bool have_device = !std::is_same<DeviceSpace, Space>::value;
-
-/// a and b are the same bits (NaN equals NaN).
-bool same_bits(double a, double b) {
-  std::uint64_t x, y;
-  std::memcpy(&x, &a, sizeof x);
-  std::memcpy(&y, &b, sizeof y);
-  return x == y;
-}
 
 /// The same bits (`relative` 0), or both NaN or within `relative` of each other (a GPU's two kernels: nvcc may contract
 /// multiply-adds differently in each).

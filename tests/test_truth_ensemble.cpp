@@ -9,6 +9,7 @@
 #include "models/linear_model.hpp"
 #include "models/ou_model.hpp"
 #include "models/sine_model.hpp"
+#include "tests/filter_test_helpers.hpp"
 #include "tests/test_spaces.hpp"
 
 #include <cmath>
@@ -201,18 +202,9 @@ void expect_truth_steps_to_be_chunks_then_moments(const Model& model, const long
     EXPECT_EQ(expected.non_finite, 1) << Model::name << ", " << members << " members, step " << k;
     EXPECT_EQ(a.members, members);
   }
-  const auto xa = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bank.state());
-  const auto xb = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), chunks.state());
-  const auto ya = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), bank.observations());
-  const auto yb = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), chunks.observations());
-  int differ = 0;
-  for (long m = 0; m < members; ++m) {
-    for (int i = 0; i < Model::state_dim; ++i)
-      differ += !(xa(m, i) == xb(m, i) || (std::isnan(xa(m, i)) && std::isnan(xb(m, i))));
-    for (int i = 0; i < Model::obs_dim; ++i)
-      differ += !(ya(m, i) == yb(m, i) || (std::isnan(ya(m, i)) && std::isnan(yb(m, i))));
-  }
-  EXPECT_EQ(differ, 0) << Model::name << ", " << members << " members";
+  EXPECT_EQ(test::entries_not_the_same_bits(bank.state(), chunks.state()), 0) << Model::name << ", " << members;
+  EXPECT_EQ(test::entries_not_the_same_bits(bank.observations(), chunks.observations()), 0)
+      << Model::name << ", " << members;
 }
 
 template <class Space>
