@@ -19,10 +19,11 @@
 #          CUDA_LAUNCH_BLOCKING=1 (no profiler is installed on the GPU machine)
 #   OUT=<dir> KUSHNER_PHASES="build run" perf/run_bank_gpu.sh
 #   ab     this tree against a baseline tree (KUSHNER_BANK_BASELINE, e.g. .baseline below, given this tree's
-#          perf/bench_filter_bank.cpp), both built light (bench_filter_bank, and test_ensemble_moments for this tree;
-#          the models' shared instances off: a few minutes for both at once on 32 cores): test_ensemble_moments,
-#          then BM_FilterBankOutputSteps (M = 1e6, every step an output step, and no output) in alternating
-#          rounds, and the kernel timer of one run of each
+#          perf/bench_filter_bank.cpp), both built light (bench_filter_bank, and test_ensemble_moments and
+#          test_filter_bank_segments for this tree; the models' shared instances off: a few minutes for both at once
+#          on 32 cores): the two tests, then the benchmarks KUSHNER_AB_BENCHMARKS picks (a regex; default
+#          BM_FilterBankOutputSteps: M = 1e6, every step an output step, and no output) in alternating rounds, and
+#          the kernel timer of one run of each
 # A baseline on the same machine: another source tree (e.g. `git archive <rev>` extracted into the git-ignored
 # .baseline/, named in `carry`) built into its own directory, then its phases run as the new tree's:
 #   KUSHNER_BANK_SOURCE=.baseline KUSHNER_BANK_BUILD=build-cuda-bank-old KUSHNER_PHASES=build perf/run_bank_gpu.sh
@@ -150,9 +151,14 @@ if want ab; then
   old_tree=$(cd "${KUSHNER_BANK_BASELINE:?ab: KUSHNER_BANK_BASELINE names the baseline tree}" && pwd)
   [ -e "$old_tree/.deps" ] || ln -s "$here/.deps" "$old_tree/.deps"
   cp "$here/perf/bench_filter_bank.cpp" "$old_tree/perf/bench_filter_bank.cpp"
+  # Ninja where there is one (the GPU machine's image has it, not on the PATH): one dependency graph per tree, its
+  # targets side by side; CMake's makefiles build the targets of one call one after another.
+  ninja=$(command -v ninja || ls /opt/torch/.venv/bin/ninja 2> /dev/null | head -1)
+  generator=()
+  [ -n "$ninja" ] && generator=(-G Ninja -DCMAKE_MAKE_PROGRAM="$ninja")
   light() {  # light SRC BUILD TARGETS...
     local src=$1 dir=$2; shift 2
-    cmake -C "$here/perf/gpu_machine.cmake" -S "$src" -B "$dir" \
+    cmake "${generator[@]}" -C "$here/perf/gpu_machine.cmake" -S "$src" -B "$dir" \
       -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON -DKUSHNER_ENABLE_OPENMP=OFF \
       -DKUSHNER_ENABLE_SERIAL=ON -DKUSHNER_ENABLE_MPI=OFF -DKUSHNER_SHARED_INSTANCES=OFF > "$out/configure_$(basename "$dir").log" 2>&1 &&
       cmake --build "$dir" -j16 --target "$@" > "$out/build_$(basename "$dir").log" 2>&1
@@ -160,15 +166,21 @@ if want ab; then
   log "ab: build $old_tree and this tree (light)"
   light "$old_tree" "$here/build-cuda-ab-old" bench_filter_bank &
   old_pid=$!
-  light "$here" "$here/build-cuda-ab-new" bench_filter_bank test_ensemble_moments || { status=1; echo "new build failed"; }
+  light "$here" "$here/build-cuda-ab-new" bench_filter_bank test_ensemble_moments test_filter_bank_segments ||
+    { status=1; echo "new build failed"; }
   wait $old_pid || { status=1; echo "old build failed"; }
   grep -h -B2 -A10 -m3 " error" "$out"/build_build-cuda-ab-*.log | head -40
   log "ab: built"
   "$here/build-cuda-ab-new/tests/test_ensemble_moments" > "$out/ab_test_ensemble_moments.log" 2>&1 || status=1
   grep -E "^\[  (PASSED|FAILED)|FAILED \]" "$out/ab_test_ensemble_moments.log" | tee -a "$out/steps.log"
+  "$here/build-cuda-ab-new/tests/test_filter_bank_segments" > "$out/ab_test_filter_bank_segments.log" 2>&1 || status=1
+  grep -E "^\[  (PASSED|FAILED|SKIPPED)|FAILED \]|SKIPPED \]" "$out/ab_test_filter_bank_segments.log" |
+    tee -a "$out/steps.log"
   for round in 1 2 3; do
     for which in old new; do
-      "$here/build-cuda-ab-$which/perf/bench_filter_bank" --benchmark_filter=BM_FilterBankOutputSteps \
+      log "ab: round $round, $which"
+      "$here/build-cuda-ab-$which/perf/bench_filter_bank" \
+        --benchmark_filter="${KUSHNER_AB_BENCHMARKS:-BM_FilterBankOutputSteps}" \
         --benchmark_repetitions=3 --benchmark_out="$out/ab-$which-$round.json" > /dev/null 2>&1 || status=1
     done
   done
