@@ -748,8 +748,10 @@ std::vector<MergedBlocks> FilterBank<ExecSpace, Model, TruthModel>::step_team_se
                   steps,
                   dt,
                   {},
+                  -1,
                   {team_columns_.update(space_, addresses)},
                   plan.num_columns,
+                  0,
                   plan.counted,
                   team_rows_,
                   num_blocks,
@@ -758,10 +760,24 @@ std::vector<MergedBlocks> FilterBank<ExecSpace, Model, TruthModel>::step_team_se
                   team_blocks_,
                   0};
   for (int s = 0; s < team_segment_max_steps; ++s) segment.output_of[s] = s < steps ? plan.output_of[s] : -1;
+  if constexpr (!host_bank) {
+    // The columns a GPU's team keeps in its block's sink: those the host's segments keep in theirs (SegmentColumn::
+    // sink), at their own column's place; each filter's slot in the launch's kernel learns where its pair starts.
+    for_each_filter_slot(segment.first.slots, [&](auto& slot) {
+      if (!slot.enabled) return;
+      const double* const squared_error = slot.snapshot.data() + snapshot_squared_error * slot.snapshot.stride(1);
+      for (int c = 0; c + 1 < plan.num_columns; ++c)
+        if (plan.columns[c].column == squared_error && plan.columns[c].sink >= 0) {
+          KUSHNER_REQUIRE(c + 1 < 64, "step_segment: " << plan.num_columns << " columns, more than a sink's 64");
+          slot.team_sink = c * moment_block_size;
+          segment.sink_mask |= std::uint64_t{3} << c;
+        }
+    });
+  }
   const auto launch = [&](const int first_block, const int blocks) {
     if (blocks == 0) return;
     segment.first_team = first_block;
-    const auto scratch = Kokkos::PerTeam(Segment::scratch_bytes);
+    const auto scratch = Kokkos::PerTeam(segment.scratch_bytes());
     if constexpr (host_bank) {  // one thread per team (team_block_statistic's form)
       Kokkos::parallel_for("kushner::filter_bank_team_segment",
                            Kokkos::TeamPolicy<ExecSpace>(space_, blocks, 1).set_scratch_size(0, scratch), segment);
@@ -776,12 +792,31 @@ std::vector<MergedBlocks> FilterBank<ExecSpace, Model, TruthModel>::step_team_se
       auto policy = Policy(space_, blocks, team_size);
       policy.set_scratch_size(0, scratch);
       Kokkos::parallel_for("kushner::filter_bank_team_segment", policy, segment);
+#if defined(KOKKOS_ENABLE_CUDA) && KOKKOS_VERSION < 40000
+      // Kokkos 3 launches a TeamPolicy kernel with cudaFuncCachePreferShared at its first launch (kokkos#2066): the
+      // shared memory for the block sinks of 3 blocks, and the rest L1, from the next launch on. On an H200 (1e6
+      // members, four filters) the sink with Kokkos' carveout made steps without outputs x0.89; with this x1.02-1.03,
+      // and output steps x1.15-1.18 (perf/filter_bank.md).
+      if constexpr (std::is_same<ExecSpace, Kokkos::Cuda>::value) {
+        using Driver = Kokkos::Impl::ParallelFor<Segment, Policy, Kokkos::Cuda>;
+        const auto kernel = Kokkos::Impl::CudaParallelLaunch<Driver, typename Policy::launch_bounds>::get_kernel_func();
+        int device = 0, per_sm = 0;
+        cudaGetDevice(&device);
+        cudaDeviceGetAttribute(&per_sm, cudaDevAttrMaxSharedMemoryPerMultiprocessor, device);
+        const double block_bytes = segment.scratch_bytes() + sizeof(double) * (team_size + 2) + 1024;  // + reserved
+        const int percent = per_sm > 0 ? std::min(100, static_cast<int>(std::ceil(300.0 * block_bytes / per_sm))) : 100;
+        KUSHNER_REQUIRE(
+            cudaFuncSetAttribute(kernel, cudaFuncAttributePreferredSharedMemoryCarveout, percent) == cudaSuccess,
+            "step_segment: cudaFuncSetAttribute (shared memory carveout) failed");
+      }
+#endif
     }
   };
   const int watched = static_cast<int>(plan.watched_blocks.size());
   for (int s = 0; s < steps && watched > 0; ++s) {
     segment.s0 = s;
     segment.s1 = s + 1;
+    segment.last_output = plan.output_of[s] >= 0 ? s : -1;
     launch(0, watched);
     if (plan.output_of[s] < 0 || !at_output) continue;
     space_.fence();
@@ -789,6 +824,7 @@ std::vector<MergedBlocks> FilterBank<ExecSpace, Model, TruthModel>::step_team_se
   }
   segment.s0 = 0;
   segment.s1 = steps;
+  segment.last_output = plan.last_output;
   launch(watched, num_blocks - watched);
 
   std::vector<MergedBlocks> merged;

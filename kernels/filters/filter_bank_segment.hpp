@@ -10,6 +10,7 @@
 // block_statistic of the same values in the same order, so the numbers are the same bits as those of steps taken one at
 // a time.
 #include "kernels/ensemble_moments.hpp"
+#include "kernels/filters/filter_slot.hpp"
 #include "kernels/for_each_member.hpp"
 #include "kernels/streaming_store.hpp"
 
@@ -102,11 +103,15 @@ constexpr int team_segment_max_steps = 32;
 /// A segment on a GPU: one team per block of moment_block_size members (a CUDA block of up to 256 threads, a member
 /// per thread), each block through every step, its columns in the SM's caches from step to step (a step at a time
 /// streamed each member's ~420 bytes from device memory and back at every step). After an output step the team's
-/// warps reduce the block's snapshot columns (written by its own threads, read after a barrier) to its BlockStatistic
+/// warps reduce the block's snapshot values (written by its own threads, read after a barrier) to its BlockStatistic
 /// rows and divergence counts, as BlockColumnStatistics' warps do after a step at a time; the rows of every output
-/// go to `rows` (output, block, width), merged where they are (MergeBlockRows). On the host (the tests' check of this
-/// form) a team is one thread, which steps its block chunk by chunk (run_member_chunk) and reduces it with
-/// team_block_statistic: the numbers of FilterBankSegment.
+/// go to `rows` (output, block, width), merged where they are (MergeBlockRows). On a GPU the columns in `sink_mask`
+/// (those of the filters whose slot has a team_sink: column c at c moment_block_size in the block's sink) are
+/// written to and reduced from shared memory, and the launch's last output step copies them to the snapshot
+/// columns, what a step at a time leaves there; 16 bytes per filter and member written to device memory and read
+/// back at every output step made such a step 1.5x a step without outputs (1e6 members, four filters, an H200). On
+/// the host (the tests' check of this form) a team is one thread, which steps its block chunk by chunk
+/// (run_member_chunk) and reduces it with team_block_statistic: the numbers of FilterBankSegment.
 template <class Step, class Counted, class MemSpace>
 struct FilterBankTeamSegment {
   Step first;  // step first_step's kernel; each step's time, index and output flag are set from it
@@ -114,8 +119,10 @@ struct FilterBankTeamSegment {
   int s0, s1;  // the steps this launch takes: first_step + s0 .. first_step + s1 - 1
   double dt;
   int output_of[team_segment_max_steps];  // per step of the segment: its output's index, or -1
+  int last_output;                        // the launch's last output step (in [s0, s1)), or -1
   ColumnAddresses<MemSpace> columns;
   int num_columns;
+  std::uint64_t sink_mask;  // GPU: bit c, column c is in the block's sink (team_sink_values)
   Counted counted;
   Kokkos::View<double*, MemSpace> rows;
   int num_blocks, width, members;
@@ -132,6 +139,8 @@ struct FilterBankTeamSegment {
     // bank, by ptxas), and a copy per team in shared memory, its fields set by the team's first thread between two
     // barriers, made every view's pointer and stride a shared-memory load and every step two barriers. The team
     // meets only at output steps, where its warps reduce what its threads wrote.
+    if (sink_mask != 0 && team.team_shmem().get_shmem(sink_bytes()) != team_sink_values())
+      Kokkos::abort("FilterBankTeamSegment: the team's scratch is not where team_sink_values looks for it");
     for (int s = s0; s < s1; ++s) {
       const long k = first_step + s;
       const bool output = output_of[s] >= 0;
@@ -140,6 +149,7 @@ struct FilterBankTeamSegment {
       if (!output) continue;
       team.team_barrier();  // every member's snapshot values are written
       reduce_block(team, output_row(s, b), begin, end, nullptr);
+      if (s == last_output) sink_to_columns(team, begin, end);  // each thread its own members' values: no barrier
       team.team_barrier();  // and read, before a later output step writes them again
     }
 #else
@@ -169,11 +179,20 @@ struct FilterBankTeamSegment {
 
   /// Team scratch of a host launch: the team's step kernel (with room to align it) and team_block_statistic's
   /// (sizeof(Step) is a multiple of its alignment, at least a double's: the doubles that follow it are aligned). A
-  /// GPU's team takes none.
+  /// GPU's team: its block's sink.
   static constexpr std::ptrdiff_t step_alignment = alignof(Step) > 16 ? alignof(Step) : 16;
-  static constexpr std::size_t scratch_bytes = Kokkos::SpaceAccessibility<Kokkos::HostSpace, MemSpace>::accessible
-                                                   ? step_alignment + sizeof(Step) + block_team_scratch_bytes
-                                                   : 0;
+  static constexpr bool host_team = Kokkos::SpaceAccessibility<Kokkos::HostSpace, MemSpace>::accessible;
+  std::size_t scratch_bytes() const {
+    return host_team ? step_alignment + sizeof(Step) + block_team_scratch_bytes : sink_bytes();
+  }
+
+  /// The block's sink: room for every column up to the last one in it.
+  KOKKOS_INLINE_FUNCTION std::ptrdiff_t sink_bytes() const {
+    int columns_in_sink = 0;
+    for (int c = 0; c < num_columns; ++c)
+      if (in_sink(c)) columns_in_sink = c + 1;
+    return static_cast<std::ptrdiff_t>(sizeof(double)) * columns_in_sink * moment_block_size;
+  }
 
  private:
   /// The host's team (one thread: FilterBank launches host teams of one) steps its block in the step kernel's own
@@ -184,6 +203,22 @@ struct FilterBankTeamSegment {
       run_member_runs(step, begin, end);
 #endif
   }
+
+  KOKKOS_INLINE_FUNCTION bool in_sink(const int c) const { return (sink_mask >> c) & 1u; }
+
+#if KUSHNER_CUDA_DEVICE_PASS
+  /// The sink's values of the members this thread steps to their snapshot columns.
+  template <class Team>
+  __device__ void sink_to_columns(const Team& team, const int begin, const int end) const {
+    const double* const sink = team_sink_values();
+    for (int c = 0; c < num_columns; ++c) {
+      if (!in_sink(c)) continue;
+      double* const column = reinterpret_cast<double*>(columns.addresses(c));
+      for (int m = begin + team.team_rank(); m < end; m += team.team_size())
+        column[m] = sink[c * moment_block_size + m - begin];
+    }
+  }
+#endif
 
   /// Block b's row of output step s's output in `rows`.
   KOKKOS_INLINE_FUNCTION double* output_row(const int s, const int b) const {
@@ -199,7 +234,10 @@ struct FilterBankTeamSegment {
     const int j = team.team_rank() % moment_lanes;
     for (int c = warp; c < num_columns + counted.columns(); c += warps) {
       if (c < num_columns) {
-        const BlockStatistic s = warp_block_statistic(j, columns(c), begin, end);
+        const BlockStatistic s =
+            in_sink(c)
+                ? warp_block_statistic(j, ColumnValue{team_sink_values() + c * moment_block_size}, 0, end - begin)
+                : warp_block_statistic(j, columns(c), begin, end);
         if (j == 0) store_block_row(row, num_columns, c, s);
       } else {
         const int counted_column = c - num_columns;

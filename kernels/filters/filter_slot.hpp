@@ -4,6 +4,7 @@
 // advance() is what the bank's fused step kernel does for one member and one filter.
 #include "core/status.hpp"
 #include "kernels/bank.hpp"
+#include "kernels/ensemble_moments.hpp"
 #include "kernels/filters/filter_protocol.hpp"
 #include "kernels/filters/filter_step.hpp"
 
@@ -42,7 +43,39 @@ struct FilterSlot {
   BankScalar<Status, MemSpace> status;  // (member): ok until the member diverges; then m, P stay frozen
   BankVector<MemSpace> score;           // (member, ScoreColumn)
   BankVector<MemSpace> snapshot;        // (member, SnapshotColumn)
+  // A GPU segment's team (FilterBankTeamSegment): where this filter's squared error and NEES columns start in its
+  // block's sink in shared memory (team_sink_values); -1: its snapshot columns. Set in the team kernel's copy only.
+  int team_sink = -1;
 };
+
+#if KUSHNER_CUDA_DEVICE_PASS
+/// A GPU segment's block sink: the snapshot values of the team's block of moment_block_size members, member m of the
+/// block at m % moment_block_size of each column, in the launch's dynamic shared memory where Kokkos puts a team's
+/// scratch (after its own team_size + 2 doubles; FilterBankTeamSegment checks that its scratch is there). Found
+/// from the block's dimensions, so no thread carries its address through the filters' steps: a sink passed to each
+/// step as an argument kept a pointer and the block's start live in every filter's step, and at 80 registers with
+/// spills that cost more than the sink saved (perf/filter_bank.md).
+__device__ inline double* team_sink_values() {
+  extern __shared__ double kushner_dynamic_shared[];
+  return kushner_dynamic_shared + blockDim.y + 2;
+}
+#endif
+
+/// A member's snapshot values at an output time: to its slot's snapshot columns, or its team's sink (team_sink).
+template <class Slot>
+KOKKOS_INLINE_FUNCTION void store_snapshot(const Slot& s, int member, double squared_error, double nees) {
+#if KUSHNER_CUDA_DEVICE_PASS
+  if (s.team_sink >= 0) {
+    static_assert((moment_block_size & (moment_block_size - 1)) == 0, "a block's members by a mask");
+    double* const values = team_sink_values() + s.team_sink + (member & (moment_block_size - 1));
+    values[0] = squared_error;
+    values[moment_block_size] = nees;
+    return;
+  }
+#endif
+  s.snapshot(member, snapshot_squared_error) = squared_error;
+  s.snapshot(member, snapshot_nees) = nees;
+}
 
 /// A member's three score sums (ScoreColumn), read together: each read-add-write of one after the other was a round
 /// trip to memory of its own (the compiler cannot move a read above a write it cannot prove apart), three per filter
@@ -71,10 +104,7 @@ KOKKOS_INLINE_FUNCTION void score_member(const Slot& s, int member, const Vec<N>
     s.score(member, nees_sum) = sums.nees + nees;
     s.score(member, nees_points) = sums.nees_points + 1.0;
   }
-  if (record) {
-    s.snapshot(member, snapshot_squared_error) = squared_error;
-    s.snapshot(member, snapshot_nees) = nees;
-  }
+  if (record) store_snapshot(s, member, squared_error, nees);
 }
 
 template <int N, class Slot>
@@ -87,7 +117,9 @@ KOKKOS_INLINE_FUNCTION void score_member(const Slot& s, int member, const Vec<N>
 template <class Slot>
 KOKKOS_INLINE_FUNCTION void mark_unscored(const Slot& s, int member) {
   if (!s.enabled) return;
-  for (int c = 0; c < num_snapshot_columns; ++c) s.snapshot(member, c) = math::quiet_nan();
+  static_assert(num_snapshot_columns == 3, "mark_unscored: every snapshot column");
+  store_snapshot(s, member, math::quiet_nan(), math::quiet_nan());
+  s.snapshot(member, snapshot_reference_squared_error) = math::quiet_nan();
 }
 
 namespace detail {
