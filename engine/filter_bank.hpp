@@ -793,21 +793,30 @@ std::vector<MergedBlocks> FilterBank<ExecSpace, Model, TruthModel>::step_team_se
       policy.set_scratch_size(0, scratch);
       Kokkos::parallel_for("kushner::filter_bank_team_segment", policy, segment);
 #if defined(KOKKOS_ENABLE_CUDA) && KOKKOS_VERSION < 40000
-      // Kokkos 3 launches a TeamPolicy kernel with cudaFuncCachePreferShared at its first launch (kokkos#2066): the
-      // shared memory for the block sinks of 3 blocks, and the rest L1, from the next launch on. On an H200 (1e6
-      // members, four filters) the sink with Kokkos' carveout made steps without outputs x0.89; with this x1.02-1.03,
-      // and output steps x1.15-1.18 (perf/filter_bank.md).
+      // Kokkos 3 launches a TeamPolicy kernel with cudaFuncCachePreferShared at its first launch (kokkos#2066, and
+      // only then: configure_shmem_preference): the shared memory for the block sinks of 3 blocks, and the rest L1,
+      // from the next launch on. On an H200 (1e6 members, four filters) the sink with Kokkos' carveout made steps
+      // without outputs x0.89; with this x1.02-1.03, and output steps x1.15-1.18 (perf/filter_bank.md). Set when
+      // it changes (a watched bank launches at every step): the device's shared memory per SM asked once.
       if constexpr (std::is_same<ExecSpace, Kokkos::Cuda>::value) {
         using Driver = Kokkos::Impl::ParallelFor<Segment, Policy, Kokkos::Cuda>;
-        const auto kernel = Kokkos::Impl::CudaParallelLaunch<Driver, typename Policy::launch_bounds>::get_kernel_func();
-        int device = 0, per_sm = 0;
-        cudaGetDevice(&device);
-        cudaDeviceGetAttribute(&per_sm, cudaDevAttrMaxSharedMemoryPerMultiprocessor, device);
+        static int per_sm = -1, carveout = -1;  // per kernel (this function's instance); one device per process
+        if (per_sm < 0) {
+          int device = 0;
+          per_sm = 0;
+          cudaGetDevice(&device);
+          cudaDeviceGetAttribute(&per_sm, cudaDevAttrMaxSharedMemoryPerMultiprocessor, device);
+        }
         const double block_bytes = segment.scratch_bytes() + sizeof(double) * (team_size + 2) + 1024;  // + reserved
         const int percent = per_sm > 0 ? std::min(100, static_cast<int>(std::ceil(300.0 * block_bytes / per_sm))) : 100;
-        KUSHNER_REQUIRE(
-            cudaFuncSetAttribute(kernel, cudaFuncAttributePreferredSharedMemoryCarveout, percent) == cudaSuccess,
-            "step_segment: cudaFuncSetAttribute (shared memory carveout) failed");
+        if (percent != carveout) {
+          const auto kernel =
+              Kokkos::Impl::CudaParallelLaunch<Driver, typename Policy::launch_bounds>::get_kernel_func();
+          KUSHNER_REQUIRE(
+              cudaFuncSetAttribute(kernel, cudaFuncAttributePreferredSharedMemoryCarveout, percent) == cudaSuccess,
+              "step_segment: cudaFuncSetAttribute (shared memory carveout) failed");
+          carveout = percent;
+        }
       }
 #endif
     }
