@@ -44,7 +44,7 @@ class TruthBank {
   /// truth_block_min_members members (simulate_truth_step_and_moments).
   EnsembleMoments step_and_moments(long k, double dt) {
     return simulate_truth_step_and_moments(space_, model_, x_, observations_, k * dt, dt, seed_,
-                                           static_cast<std::uint32_t>(k));
+                                           static_cast<std::uint32_t>(k), moment_rows_);
   }
 
   const BankVector<MemSpace>& state() const { return x_; }
@@ -55,6 +55,7 @@ class TruthBank {
   Model model_;
   Seed seed_;
   BankVector<MemSpace> x_, observations_;
+  MomentRows<MemSpace> moment_rows_;  // step_and_moments' block rows, from output step to output step
 };
 
 template <class ExecSpace, class Model>

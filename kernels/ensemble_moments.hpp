@@ -658,17 +658,47 @@ inline EnsembleMoments moments_of_block_rows(const double* rows, const std::size
   return result;
 }
 
-/// Mean and sample variance of every column of x(member, column) over members.
+/// A reduction's block rows (BlockStatistics) and their copy on the host, kept by a caller that reduces banks of the
+/// same shape again and again (an output step after another): on a GPU an allocation and its release each wait for
+/// the device, and a copy to pageable host memory goes through a staging buffer of the driver's.
+template <class MemSpace>
+class MomentRows {
+ public:
+  using HostRows = Kokkos::View<double**, Kokkos::LayoutRight, typename HostStaging<MemSpace>::space>;
+
+  /// Rows of `blocks` blocks of `width` doubles, allocated (on `space`) only when the shape changes.
+  template <class ExecSpace>
+  const BlockStatistics<MemSpace>& rows(const ExecSpace& space, const int blocks, const int width) {
+    if (rows_.extent(0) != static_cast<std::size_t>(blocks) || rows_.extent(1) != static_cast<std::size_t>(width)) {
+      // Allocated on `space`, not on the default execution space: with a few members on Serial, an OpenMP fork and
+      // join per call cost more than the moments (kushner reproduce's one-member runs).
+      rows_ = BlockStatistics<MemSpace>(
+          Kokkos::view_alloc(space, Kokkos::WithoutInitializing, "kushner::moment_blocks"), blocks, width);
+      host_ = Kokkos::create_mirror_view(typename HostStaging<MemSpace>::space(), rows_);  // the rows, or a pinned copy
+    }
+    return rows_;
+  }
+
+  /// Queues the rows' copy to host() on `space` (nothing to copy where they are host memory).
+  template <class ExecSpace>
+  void copy_to_host(const ExecSpace& space) const {
+    if (host_.data() != rows_.data()) Kokkos::deep_copy(space, host_, rows_);
+  }
+  const HostRows& host() const { return host_; }
+
+ private:
+  BlockStatistics<MemSpace> rows_;
+  HostRows host_;
+};
+
+/// Mean and sample variance of every column of x(member, column) over members, its block rows in `rows`.
 template <class ExecSpace, class View>
-EnsembleMoments ensemble_moments(const ExecSpace& space, const View& x) {
+EnsembleMoments ensemble_moments(const ExecSpace& space, const View& x, MomentRows<typename View::memory_space>& rows) {
   using MemSpace = typename View::memory_space;
   const int members = static_cast<int>(x.extent(0));
   const int columns = static_cast<int>(x.extent(1));
   const int num_blocks = static_cast<int>(moment_blocks(members));
-  // Allocated on `space`, not on the default execution space: with a few members on Serial, an OpenMP fork and
-  // join per call cost more than the moments (kushner reproduce's one-member runs).
-  BlockStatistics<MemSpace> blocks(Kokkos::view_alloc(space, Kokkos::WithoutInitializing, "kushner::moment_blocks"),
-                                   num_blocks, 3 * columns);
+  const BlockStatistics<MemSpace>& blocks = rows.rows(space, num_blocks, 3 * columns);
   const auto launch = [&](auto fixed_columns) {
     using Rows = FiniteRows<View, decltype(fixed_columns)::value>;
     launch_block_statistics("kushner::block_moments", space, num_blocks * columns, block_teams_by_default<MemSpace>,
@@ -681,9 +711,16 @@ EnsembleMoments ensemble_moments(const ExecSpace& space, const View& x) {
     case 4: launch(std::integral_constant<int, 4>{}); break;
     default: launch(std::integral_constant<int, -1>{});
   }
+  rows.copy_to_host(space);
   space.fence();
-  const auto rows = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), blocks);
-  return moments_of_block_rows(rows.data(), rows.size(), columns, members);
+  return moments_of_block_rows(rows.host().data(), rows.host().size(), columns, members);
+}
+
+/// ensemble_moments with rows of its own (a single reduction).
+template <class ExecSpace, class View>
+EnsembleMoments ensemble_moments(const ExecSpace& space, const View& x) {
+  MomentRows<typename View::memory_space> rows;
+  return ensemble_moments(space, x, rows);
 }
 
 }  // namespace kushner
@@ -726,18 +763,11 @@ class ColumnMoments {
       addresses.push_back(reinterpret_cast<std::uintptr_t>(columns[c].data()));
     }
     const auto& pointers = columns_.update(space, addresses);
-    const int width = 3 * num_columns_ + num_counted_;
-    if (blocks_.extent(0) != static_cast<std::size_t>(num_blocks) ||
-        blocks_.extent(1) != static_cast<std::size_t>(width)) {
-      blocks_ = BlockStatistics<MemSpace>(
-          Kokkos::view_alloc(space, Kokkos::WithoutInitializing, "kushner::moment_blocks"), num_blocks, width);
-      // The blocks themselves in host memory; a page-locked copy of them on a GPU.
-      rows_ = Kokkos::create_mirror_view(typename HostStaging<MemSpace>::space(), blocks_);
-    }
+    const BlockStatistics<MemSpace>& blocks = rows_.rows(space, num_blocks, 3 * num_columns_ + num_counted_);
     launch_block_statistics("kushner::block_column_moments", space, num_blocks * (num_columns_ + num_counted_), teams_,
                             BlockColumnStatistics<ColumnAddresses<MemSpace>, MemSpace, Counted>{
-                                {pointers}, num_columns_, counted, members_, blocks_});
-    if (rows_.data() != blocks_.data()) Kokkos::deep_copy(space, rows_, blocks_);
+                                {pointers}, num_columns_, counted, members_, blocks});
+    rows_.copy_to_host(space);
     done_.record(space);
   }
 
@@ -746,14 +776,12 @@ class ColumnMoments {
   MergedBlocks finish() {
     if (num_columns_ == 0) return {};
     done_.wait();
-    return merge_block_statistics(rows_.data(), rows_.size(), num_columns_, num_counted_, members_);
+    return merge_block_statistics(rows_.host().data(), rows_.host().size(), num_columns_, num_counted_, members_);
   }
 
  private:
-  using HostRows = Kokkos::View<double**, Kokkos::LayoutRight, typename HostStaging<MemSpace>::space>;
   DeviceAddresses<MemSpace> columns_;
-  BlockStatistics<MemSpace> blocks_;
-  HostRows rows_;  // blocks_ (on the host) or its page-locked copy
+  MomentRows<MemSpace> rows_;
   bool teams_;
   int num_columns_ = 0, num_counted_ = 0, members_ = 0;  // of the last start()
   QueueMark<ExecSpace> done_;                            // after the last start()'s copy

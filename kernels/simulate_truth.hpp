@@ -331,24 +331,25 @@ void simulate_truth_step(const ExecSpace& space, const Model& model, const BankV
 /// simulate_truth_step, then ensemble_moments of the state it leaves (the same bits; over every rank: a collective
 /// call). By blocks on the host (TruthStepBlocks) in one pass: a reduction of its own read the whole state back from
 /// memory, as much as a tenth of the cubic oscillator's step at 1e6 members (x and dy 32 MB, more than the caches
-/// hold; perf/filter_bank.md). On a GPU, or with few members, the two in turn.
+/// hold; perf/filter_bank.md). On a GPU, or with few members, the two in turn. The block rows in `rows`.
 template <class ExecSpace, class Model, class MemSpace>
 EnsembleMoments simulate_truth_step_and_moments(const ExecSpace& space, const Model& model,
                                                 const BankVector<MemSpace>& x, const BankVector<MemSpace>& observations,
-                                                double t, double dt, Seed seed, std::uint32_t step) {
+                                                double t, double dt, Seed seed, std::uint32_t step,
+                                                MomentRows<MemSpace>& rows) {
   if constexpr (std::is_same<MemSpace, Kokkos::HostSpace>::value) {
     if (truth_step_by_blocks(x)) {
       require_truth_banks<Model>(x, observations);
       const int members = x.extent_int(0);
-      BlockStatistics<MemSpace> blocks(Kokkos::view_alloc(Kokkos::WithoutInitializing, "kushner::moment_blocks"),
-                                       moment_blocks(members), 3 * Model::state_dim);
+      const BlockStatistics<MemSpace>& blocks =
+          rows.rows(space, static_cast<int>(moment_blocks(members)), 3 * Model::state_dim);
       step_truth_blocks(space, model, x, observations, t, dt, seed, step, blocks);
       space.fence();
       return moments_of_block_rows(blocks.data(), blocks.size(), Model::state_dim, members);
     }
   }
   simulate_truth_step(space, model, x, observations, t, dt, seed, step);
-  return ensemble_moments(space, x);
+  return ensemble_moments(space, x, rows);
 }
 
 }  // namespace kushner

@@ -129,10 +129,11 @@ ControllerRun run_controller(const ExecSpace& space, const Model& model, long me
   });
 
   Loop loop(space, model, members, rank_seed, spec.estimator, law.law, cost, options, particle, prepared);
+  MomentRows<MemSpace> state_rows, control_rows;  // from output step to output step
   auto record = [&](double t) {
     if (times) times->push_back(t);
-    run.state_mean.push_back(ensemble_moments(space, loop.truths().state()).mean);
-    run.control_mean.push_back(ensemble_moments(space, loop.control()).mean);
+    run.state_mean.push_back(ensemble_moments(space, loop.truths().state(), state_rows).mean);
+    run.control_mean.push_back(ensemble_moments(space, loop.control(), control_rows).mean);
     const std::vector<double> running = collective::gather(loop.member_running_cost());
     double sum = 0.0;
     long count = 0;
@@ -162,7 +163,7 @@ ControllerRun run_controller(const ExecSpace& space, const Model& model, long me
   run.cost = collective::gather(loop.member_costs());
   run.control_energy = collective::gather(loop.member_control_energy());
   run.squared_error = collective::gather(loop.member_squared_error());
-  run.terminal_mean = ensemble_moments(space, loop.truths().state()).mean;
+  run.terminal_mean = ensemble_moments(space, loop.truths().state(), state_rows).mean;
   run.truths_escaped = loop.truths_escaped();
   run.estimator_diverged = loop.estimator_diverged();
   run.estimator_fields = loop.estimator_fields();
