@@ -47,6 +47,9 @@ class TruthBank {
                                            static_cast<std::uint32_t>(k), moment_rows_);
   }
 
+  /// ensemble_moments(state()) with step_and_moments' rows (a collective call).
+  EnsembleMoments moments() { return ensemble_moments(space_, x_, moment_rows_); }
+
   const BankVector<MemSpace>& state() const { return x_; }
   const BankVector<MemSpace>& observations() const { return observations_; }
 
@@ -55,7 +58,7 @@ class TruthBank {
   Model model_;
   Seed seed_;
   BankVector<MemSpace> x_, observations_;
-  MomentRows<MemSpace> moment_rows_;  // step_and_moments' block rows, from output step to output step
+  MomentRows<MemSpace> moment_rows_;  // the moments' block rows, from output step to output step
 };
 
 template <class ExecSpace, class Model>
@@ -75,7 +78,7 @@ MomentSeries simulate_ensemble(const ExecSpace& space, const Model& model, long 
   };
   space.fence();
   const auto loop_start = std::chrono::steady_clock::now();
-  if (output_at(0)) series.moments.push_back(ensemble_moments(space, bank.state()));
+  if (output_at(0)) series.moments.push_back(bank.moments());
   for (long k = 0; k < grid.steps; ++k) {
     if (output_at(k + 1))  // the moments of the state step k leaves
       series.moments.push_back(bank.step_and_moments(k, grid.dt));

@@ -144,19 +144,40 @@ __device__ BlockStatistic warp_statistic(const double count, const double sum, c
 /// lane j): the same sums in the same order, so the same bits up to the multiply-adds nvcc contracts. Each lane
 /// loads its (up to) moment_lane_members values at once and keeps them in registers for the second pass; the lanes
 /// meet by shuffles. A position past the block's end reads the block's last value (so no branch keeps the reads from
-/// going out at once) and counts as NaN, which adds zero to every sum, as block_statistic's shorter loop adds
-/// nothing. (The first team form, which loaded a lane's values one after another, four at a time as nvcc
-/// unrolled the loop, loaded them again for the second pass, and had every thread add the 32 lanes from team
-/// scratch, took 49-67 us for 8 columns of 1e6 members on an H200, 2.8-3.9x a read of them.)
+/// going out at once) and adds zero to every sum, as block_statistic's shorter loop adds nothing. As there, a block
+/// whose total is finite takes the passes unmasked (the masked ones would add the same values in the same order),
+/// and the masked passes count only the finite values. (The first team form, which loaded a lane's values one after
+/// another, four at a time as nvcc unrolled the loop, loaded them again for the second pass, and had every thread
+/// add the 32 lanes from team scratch, took 49-67 us for 8 columns of 1e6 members on an H200, 2.8-3.9x a read of
+/// them.)
 template <class Value>
 __device__ BlockStatistic warp_block_statistic(const int j, const Value& value, const int begin, const int end) {
   constexpr int L = moment_lanes, K = moment_lane_members;
-  double v[K], count = 0.0, sum = 0.0;
+  const int n = end - begin;
+  double v[K], sum = 0.0;
   KUSHNER_DEVICE_UNROLL
-  for (int k = 0; k < K; ++k) v[k] = value(begin + j + k * L < end ? begin + j + k * L : end - 1);  // no branch
+  for (int k = 0; k < K; ++k) v[k] = value(j + k * L < n ? begin + j + k * L : end - 1);  // no branch
+  KUSHNER_DEVICE_UNROLL
+  for (int k = 0; k < K; ++k) sum += j + k * L < n ? v[k] : 0.0;
+  const double total = warp_pairwise_sum(sum);  // the same on every lane, so the branch below is the warp's
+  if (n > 0 && math::is_finite(total)) {
+    BlockStatistic s;
+    s.count = static_cast<double>(n);
+    s.mean = total / s.count;
+    double ss = 0.0;
+    KUSHNER_DEVICE_UNROLL
+    for (int k = 0; k < K; ++k) {
+      const double d = j + k * L < n ? v[k] - s.mean : 0.0;
+      ss += d * d;
+    }
+    s.m2 = warp_pairwise_sum(ss);
+    return s;
+  }
+  double count = 0.0;
+  sum = 0.0;
   KUSHNER_DEVICE_UNROLL
   for (int k = 0; k < K; ++k) {
-    if (begin + j + k * L >= end) v[k] = math::quiet_nan();
+    if (j + k * L >= n) v[k] = math::quiet_nan();
     const bool finite = math::is_finite(v[k]);
     count += finite ? 1.0 : 0.0;
     sum += finite ? v[k] : 0.0;
@@ -716,7 +737,9 @@ EnsembleMoments ensemble_moments(const ExecSpace& space, const View& x, MomentRo
   return moments_of_block_rows(rows.host().data(), rows.host().size(), columns, members);
 }
 
-/// ensemble_moments with rows of its own (a single reduction).
+/// ensemble_moments with rows of its own (a single reduction). Their host copy is page-locked on a GPU too: allocated
+/// for one call it still took 0.66x the time of a pageable one (perf/bench_simulate_truth's BM_Moments, H200, 1e6
+/// members: 68 against 104 us; rows kept from call to call 36 us).
 template <class ExecSpace, class View>
 EnsembleMoments ensemble_moments(const ExecSpace& space, const View& x) {
   MomentRows<typename View::memory_space> rows;

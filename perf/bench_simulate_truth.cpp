@@ -37,6 +37,26 @@ void BM_OutputStep(benchmark::State& state) {
   time_truth_steps(state, bank, /*moments=*/true);
 }
 
+/// ensemble_moments of a bank's state alone (no step): `kept` 1 with block rows and a (page-locked on a GPU) host copy
+/// kept from call to call, as an output step after another takes them; 0 with rows of its own each time, as a single
+/// reduction (simulate's first output, a filter's end-of-run score) takes them.
+template <class Model>
+void BM_Moments(benchmark::State& state) {
+  using Space = Kokkos::DefaultExecutionSpace;
+  TruthBank<Space, Model> bank(Space(), Model{}, state.range(0), 42);
+  MomentRows<Space::memory_space> rows;
+  const Space space;
+  for (auto _ : state) {
+    space.fence();
+    Kokkos::Timer timer;
+    if (state.range(1) != 0)
+      benchmark::DoNotOptimize(ensemble_moments(space, bank.state(), rows).mean);
+    else
+      benchmark::DoNotOptimize(ensemble_moments(space, bank.state()).mean);
+    state.SetIterationTime(timer.seconds());
+  }
+}
+
 /// The physical floor: copying the bytes one step moves.
 template <class Model>
 void BM_StreamCopy(benchmark::State& state) {
@@ -49,6 +69,11 @@ BENCHMARK_TEMPLATE(BM_TruthStep, CubicOscillatorModel)->ArgName("members")->Arg(
 BENCHMARK_TEMPLATE(BM_StreamCopy, CubicOscillatorModel)->ArgName("members")->Arg(1000000)->UseManualTime();
 BENCHMARK_TEMPLATE(BM_OutputStep, SineModel)->ArgName("members")->Arg(1000000)->UseManualTime();
 BENCHMARK_TEMPLATE(BM_OutputStep, CubicOscillatorModel)->ArgName("members")->Arg(1000000)->UseManualTime();
+BENCHMARK_TEMPLATE(BM_Moments, SineModel)
+    ->ArgNames({"members", "kept"})
+    ->Args({1000000, 1})
+    ->Args({1000000, 0})
+    ->UseManualTime();
 
 }  // namespace
 }  // namespace kushner
