@@ -75,6 +75,17 @@ KOKKOS_INLINE_FUNCTION double cos_apart_from_sin(double x) {
 #endif
 }
 
+/// s = sin(x), c = cos(x) with the same bits as math::sin and cos_apart_from_sin (on a GPU too: test_model_forms). On a
+/// GPU CUDA's sincos: one range reduction for both (nvcc does not merge those of a sin and a cos of the same x).
+KOKKOS_INLINE_FUNCTION void sin_cos(double x, double& s, double& c) {
+#if KUSHNER_CUDA_DEVICE_PASS
+  ::sincos(x, &s, &c);
+#else
+  s = sin(x);
+  c = cos_apart_from_sin(x);
+#endif
+}
+
 /// Host: cos(2 pi u) as cos_sin_two_pi computes its c there, the same bits (one expression for both).
 inline double cos_two_pi_host(double u) { return cos(2.0 * pi * u); }
 

@@ -85,6 +85,13 @@ struct SdcDrift {
   Vec<N> b;
 };
 
+/// f(x) and its Jacobian at one point, from a model that computes them together (drift_and_jacobian).
+template <int N>
+struct DriftAndJacobian {
+  Vec<N> drift;
+  Mat<N, N> jacobian;
+};
+
 /// Gaussian expectations of the drift under x ~ N(m, P): mean = E[f(x)], jacobian = E[grad f(x)], which by
 /// Stein's lemma equals Sunahara's E[(f - a)(x - m)^T] P^{-1} (seed 000 (5.12b)) and needs no P^{-1}.
 template <int N>

@@ -44,6 +44,14 @@ struct has_sdc_drift<Model, std::void_t<decltype(std::declval<const Model&>().sd
                                 0.0, std::declval<const Vec<Model::state_dim>&>()))>> : std::true_type {};
 
 template <class Model, class = void>
+struct has_drift_and_jacobian : std::false_type {};
+template <class Model>
+struct has_drift_and_jacobian<
+    Model, std::void_t<decltype(std::declval<const Model&>().drift_and_jacobian(
+               0.0, std::declval<const Vec<Model::state_dim>&>(), std::declval<const typename Model::Control&>()))>>
+    : std::true_type {};
+
+template <class Model, class = void>
 struct has_gaussian_observation : std::false_type {};
 template <class Model>
 struct has_gaussian_observation<Model, std::void_t<decltype(std::declval<const Model&>().gaussian_observation(
@@ -109,6 +117,18 @@ struct ModelTraits {
       return linear ? 1 : 0;
   }
 };
+
+/// f(t, x, u) and df/dx(t, x, u): the model's drift_and_jacobian where it has one (e.g. a sine and a cosine of one
+/// argument, one range reduction on a GPU: math::sin_cos), else drift and drift_jacobian.
+template <class Model>
+KOKKOS_INLINE_FUNCTION DriftAndJacobian<Model::state_dim> drift_and_jacobian(const Model& model, double t,
+                                                                             const Vec<Model::state_dim>& x,
+                                                                             const typename Model::Control& u) {
+  if constexpr (detail::has_drift_and_jacobian<Model>::value)
+    return model.drift_and_jacobian(t, x, u);
+  else
+    return {model.drift(t, x, u), model.drift_jacobian(t, x, u)};
+}
 
 /// The drift as a componentwise power polynomial (degree 1 for a linear model).
 template <class Model>

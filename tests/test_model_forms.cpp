@@ -46,6 +46,13 @@ void expect_forms_match_drift(const Model& model) {
   for (int k = 0; k < 5; ++k) {
     const Vec<n> x = test_point<Model>(k);
     const Vec<n> f = model.drift(t, x, u);
+    const DriftAndJacobian<n> together = drift_and_jacobian(model, t, x, u);
+    const Mat<n, n> J = model.drift_jacobian(t, x, u);
+    for (int i = 0; i < n; ++i) {
+      EXPECT_EQ(together.drift[i], f[i]) << name << " drift_and_jacobian's drift [" << i << "]";
+      for (int j = 0; j < n; ++j)
+        EXPECT_EQ(together.jacobian(i, j), J(i, j)) << name << " drift_and_jacobian's (" << i << ", " << j << ")";
+    }
     if constexpr (T::power_polynomial)
       expect_vectors_near(drift_power_polynomial(model, t)(x), f, 1e-13, name + " power polynomial");
     if constexpr (T::quadratic_polynomial)
@@ -125,6 +132,31 @@ TEST(ModelForms, EveryFormAModelHasDescribesItsDrift) {
   EXPECT_EQ(checked, 13);             // ou, sine, cubic-oscillator, linear 1-3, car, car-taylor3, terpolymer, benes,
                                       // cubic-sensor, pendulum, range-bearing
   EXPECT_EQ(with_float_dynamics, 5);  // ou, sine, linear 1-3
+}
+
+/// Counts the points where the sine model's drift_and_jacobian differs from its drift and drift_jacobian: arguments
+/// up to 100, and every 7th up to 1e6 (the slow range reduction past ~2^20 too), of both signs.
+struct SineDriftAndJacobianMismatches {
+  SineModel sine;
+  int points;
+  KOKKOS_INLINE_FUNCTION void operator()(const int i, int& count) const {
+    const double r = static_cast<double>(i) / points;
+    const Vec<1> x{{(i % 2 == 0 ? 1.0 : -1.0) * r * r * (i % 7 == 0 ? 1e6 : 100.0)}};
+    const auto u = SineModel::Control::zero();
+    const DriftAndJacobian<1> together = sine.drift_and_jacobian(0.0, x, u);
+    count += together.drift[0] == sine.drift(0.0, x, u)[0] ? 0 : 1;
+    count += together.jacobian(0, 0) == sine.drift_jacobian(0.0, x, u)(0, 0) ? 0 : 1;
+  }
+};
+
+/// Where the kernels run (a GPU in a CUDA build, where drift_and_jacobian takes one sincos): the same bits.
+TEST(ModelForms, SineDriftAndJacobianAreItsDriftAndJacobianWhereKernelsRun) {
+  using Space = Kokkos::DefaultExecutionSpace;
+  constexpr int points = 200000;
+  int differ = 0;
+  Kokkos::parallel_reduce("test::sine_drift_and_jacobian", Kokkos::RangePolicy<Space>(0, points),
+                          SineDriftAndJacobianMismatches{SineModel{}, points}, differ);
+  EXPECT_EQ(differ, 0) << "of " << 2 * points << " values, on " << Space::name();
 }
 
 TEST(ModelForms, ClosedFormExpectationsDifferFromThePointValues) {  // power: E_N[f] != f(m) for nonlinear f

@@ -1,6 +1,7 @@
 #pragma once
 // First-order (Taylor) linearizations at a point, shared by the EKF family, the second-order filters and KBL.
 #include "kernels/filters/filter_step.hpp"
+#include "models/model_traits.hpp"
 
 namespace kushner {
 
@@ -15,8 +16,8 @@ KOKKOS_INLINE_FUNCTION ObservationLinearization<Model::state_dim, Model::obs_dim
 template <class Model>
 KOKKOS_INLINE_FUNCTION DriftLinearization<Model::state_dim> drift_linearization(const Model& model, double t,
                                                                                 const Vec<Model::state_dim>& x) {
-  const auto u = Model::Control::zero();
-  return {model.drift(t, x, u), model.drift_jacobian(t, x, u), noise_intensity(model.diffusion(t, x))};
+  const auto f = drift_and_jacobian(model, t, x, Model::Control::zero());
+  return {f.drift, f.jacobian, noise_intensity(model.diffusion(t, x))};
 }
 
 }  // namespace kushner
