@@ -46,12 +46,17 @@ void expect_forms_match_drift(const Model& model) {
   for (int k = 0; k < 5; ++k) {
     const Vec<n> x = test_point<Model>(k);
     const Vec<n> f = model.drift(t, x, u);
-    const DriftAndJacobian<n> together = drift_and_jacobian(model, t, x, u);
-    const Mat<n, n> J = model.drift_jacobian(t, x, u);
-    for (int i = 0; i < n; ++i) {
-      EXPECT_EQ(together.drift[i], f[i]) << name << " drift_and_jacobian's drift [" << i << "]";
-      for (int j = 0; j < n; ++j)
-        EXPECT_EQ(together.jacobian(i, j), J(i, j)) << name << " drift_and_jacobian's (" << i << ", " << j << ")";
+    typename Model::Control pushed = Model::Control::zero();  // a control input as well, for a model that has one
+    for (int i = 0; i < Model::control_dim; ++i) pushed[i] = 0.7 - 0.2 * i;
+    for (const auto& control : {u, pushed}) {
+      const DriftAndJacobian<n> together = drift_and_jacobian(model, t, x, control);
+      const Vec<n> drift = model.drift(t, x, control);
+      const Mat<n, n> J = model.drift_jacobian(t, x, control);
+      for (int i = 0; i < n; ++i) {
+        EXPECT_EQ(together.drift[i], drift[i]) << name << " drift_and_jacobian's drift [" << i << "]";
+        for (int j = 0; j < n; ++j)
+          EXPECT_EQ(together.jacobian(i, j), J(i, j)) << name << " drift_and_jacobian's (" << i << ", " << j << ")";
+      }
     }
     if constexpr (T::power_polynomial)
       expect_vectors_near(drift_power_polynomial(model, t)(x), f, 1e-13, name + " power polynomial");
