@@ -42,8 +42,8 @@ RiccatiSolution<Model::state_dim, Model::control_dim> lqr_solution(const Model& 
   const auto u0 = Model::Control::zero();
   return solve_affine_lqr<n, m>(steps, dt, cost, noise_intensity_at(model, 0.0, x_lin), [&](long k) {
     const double t = k * dt;
-    const Mat<n, n> A = model.drift_jacobian(t, x_lin, u0);
-    return AffineCoefficients<n, m>{A, model.drift(t, x_lin, u0) - A * x_lin, model.control_input(t)};
+    const auto f = drift_and_jacobian(model, t, x_lin, u0);
+    return AffineCoefficients<n, m>{f.jacobian, f.drift - f.jacobian * x_lin, model.control_input(t)};
   });
 }
 

@@ -58,8 +58,9 @@ KOKKOS_INLINE_FUNCTION bool cubature_drift(const Model& model, double t, const V
   const auto u = Model::Control::zero();
   out = GaussianDrift<n>{Vec<n>::zero(), Mat<n, n>::zero()};
   for_each_cubature_node(rule, m, L, [&](const Vec<n>& x, double w) {
-    out.mean += model.drift(t, x, u) * w;
-    out.jacobian += model.drift_jacobian(t, x, u) * w;
+    const auto f = drift_and_jacobian(model, t, x, u);
+    out.mean += f.drift * w;
+    out.jacobian += f.jacobian * w;
   });
   return true;
 }

@@ -23,7 +23,7 @@ struct SecondOrderStep {
     if (!kalman_update(obs, in, m, P, w)) return Status::not_positive_definite;
     if constexpr (WithCurvatureTerm) P = symmetrize(P + observation_curvature_term(model, in.t, m0, P0, w));
     DriftLinearization<n> drift = drift_linearization(model, in.t, m);
-    drift.a = hessian_corrected_drift(model, in.t, m, P);
+    drift.a += drift_curvature(model, in.t, m, P);
     euler_predict(drift, in.dt, m, P);
     return Status::ok;
   }

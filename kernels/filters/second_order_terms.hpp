@@ -13,15 +13,15 @@ KOKKOS_INLINE_FUNCTION double frobenius(const Mat<N, N>& A, const Mat<N, N>& B) 
   return s;
 }
 
-/// f_i(m) + 1/2 tr(Hess f_i(m) P), seed 000 (6.9).
+/// 1/2 tr(Hess f_i(m) P) for each i: what seed 000 (6.9) adds to f_i(m) (the caller has f(m) from its linearization).
 template <class Model>
-KOKKOS_INLINE_FUNCTION Vec<Model::state_dim> hessian_corrected_drift(const Model& model, double t,
-                                                                     const Vec<Model::state_dim>& m,
-                                                                     const Mat<Model::state_dim, Model::state_dim>& P) {
+KOKKOS_INLINE_FUNCTION Vec<Model::state_dim> drift_curvature(const Model& model, double t,
+                                                             const Vec<Model::state_dim>& m,
+                                                             const Mat<Model::state_dim, Model::state_dim>& P) {
   const auto u = Model::Control::zero();
-  Vec<Model::state_dim> a = model.drift(t, m, u);
-  for (int i = 0; i < Model::state_dim; ++i) a[i] += 0.5 * frobenius(model.drift_hessian(t, m, u, i), P);
-  return a;
+  Vec<Model::state_dim> c;
+  for (int i = 0; i < Model::state_dim; ++i) c[i] = 0.5 * frobenius(model.drift_hessian(t, m, u, i), P);
+  return c;
 }
 
 /// h_l(m) + 1/2 tr(Hess h_l(m) P): the predicted observation of rows [9], [12] (the "- 1/2 p h''" of n(x)).
