@@ -16,6 +16,7 @@
 #include "kernels/filters/filter_list.hpp"
 #include "kernels/filters/filter_metrics.hpp"
 #include "kernels/for_each_member.hpp"
+#include "kernels/queue_mark.hpp"
 
 #include <Kokkos_Core.hpp>
 
@@ -191,12 +192,12 @@ class FilterBank {
            static_cast<double>(filters) * (sizeof(double) * n + sizeof(Status));
   }
 
-  /// Whether step_segment may run: no estimator steps beside the bank.
+  /// Whether start_segment may run: no estimator steps beside the bank.
   bool steps_in_segments() const { return reference_ == nullptr && estimators_.empty(); }
 
   /// A bank in host memory (stepped in chunks of SIMD lanes).
   static constexpr bool host_bank = Kokkos::SpaceAccessibility<Kokkos::HostSpace, MemSpace>::accessible;
-  /// Whether step_segment runs its team form (FilterBankTeamSegment: a GPU's) rather than the host's chunk form
+  /// Whether start_segment runs its team form (FilterBankTeamSegment: a GPU's) rather than the host's chunk form
   /// (FilterBankSegment); a device bank runs only the team form. The tests run the team form on the host as well.
   bool segment_teams() const { return segment_teams_; }
   void set_segment_teams(bool teams) {
@@ -208,17 +209,20 @@ class FilterBank {
   /// fewer trips to memory, and their block statistics (output steps) in a few MB.
   static constexpr int segment_steps = 16;
 
-  /// Steps k .. k + outputs.size() - 1 in one pass over blocks of members (temporal blocking:
+  /// Queues steps k .. k + outputs.size() - 1 in one pass over blocks of members (temporal blocking:
   /// kernels/filters/filter_bank_segment.hpp), with the numbers of step() one step at a time (steps_in_segments();
   /// on a GPU up to the multiply-adds nvcc contracts; at most team_segment_max_steps steps in the team form).
   /// outputs[s] != 0: step k + s ends at an output time. The members `watched` (indices into this bank) take the steps
   /// one at a time first, and after each output step at_output(s) is called with them there: every other member is
-  /// then at the segment's start, so at_output may read only the watched ones. Returns snapshots(names) of each output
-  /// step, in order (a collective call over the ranks, as finish_snapshots is).
-  std::vector<std::vector<FilterSnapshot>> step_segment(long k, double dt, const std::vector<char>& outputs,
-                                                        const std::vector<std::string>& names,
-                                                        const std::vector<long>& watched = {},
-                                                        const std::function<void(int)>& at_output = {});
+  /// then at the segment's start, so at_output may read only the watched ones. finish_segment waits for the oldest
+  /// started segment's outputs and returns snapshots(names) of each, in order (a collective call over the ranks, as
+  /// finish_snapshots is). A second segment may be started before the first is finished: engine/filter_run.hpp queues
+  /// the next segment first, so that on a GPU the host merges one segment's outputs while the device takes the next
+  /// (waiting for them at once left the device idle meanwhile). Where a segment's outputs are merged as it is taken
+  /// (the host's forms, several ranks), start_segment waits for them.
+  void start_segment(long k, double dt, const std::vector<char>& outputs, const std::vector<std::string>& names,
+                     const std::vector<long>& watched = {}, const std::function<void(int)>& at_output = {});
+  std::vector<std::vector<FilterSnapshot>> finish_segment();
 
   const TruthBank<ExecSpace, TruthModel>& truths() const { return truths_; }
   /// (member): non_finite once the member's truth escaped to infinity.
@@ -443,7 +447,7 @@ class FilterBank {
     std::vector<int> first;  // names[i]'s first column in snapshot_moments_
   };
   mutable PendingSnapshots pending_;
-  /// What both forms of step_segment need: per step its output's index (or -1), the snapshot columns of `names`
+  /// What both forms of start_segment need: per step its output's index (or -1), the snapshot columns of `names`
   /// (host form: with their places in the sink), their divergence counts, the blocks of the watched members.
   struct SegmentPlan {
     std::vector<int> output_of;
@@ -466,20 +470,33 @@ class FilterBank {
                                               plan.counted.columns(), members_));
     return merged;
   }
-  /// step_segment's forms: they step the bank and leave each output's merged moments.
-  std::vector<MergedBlocks> step_host_segment(long k, double dt, const SegmentPlan& plan,
-                                              const std::function<void(int)>& at_output);
-  std::vector<MergedBlocks> step_team_segment(long k, double dt, const SegmentPlan& plan,
-                                              const std::function<void(int)>& at_output);
+  /// A started segment's outputs: merged already, or on their way to `sums` (rows (output, width), host memory).
+  struct PendingSegment {
+    std::vector<std::string> names;
+    std::vector<int> first;
+    int num_outputs = 0, num_columns = 0, num_counted = 0;
+    std::vector<MergedBlocks> merged;
+    Kokkos::View<const double**, Kokkos::LayoutRight, typename HostStaging<MemSpace>::space> sums;
+    QueueMark<ExecSpace> copied;  // after the copy to `sums`
+  };
+  std::vector<PendingSegment> pending_segments_;  // oldest first, at most two (team_sums_' two halves)
+  /// start_segment's forms: they step the bank and leave each output's merged moments in `pending` (the team form on
+  /// one process: their sums on the way to the host).
+  void step_host_segment(long k, double dt, const SegmentPlan& plan, const std::function<void(int)>& at_output,
+                         PendingSegment& pending);
+  void step_team_segment(long k, double dt, const SegmentPlan& plan, const std::function<void(int)>& at_output,
+                         PendingSegment& pending);
 
   bool segment_teams_ = !host_bank;
   std::vector<double> segment_rows_;  // the host form's block statistics, kept from one segment to the next
   // The team form's buffers, kept from one segment to the next (on a GPU an allocation waits for the device): the
-  // rows (output, block, width), their merged sums (output, width) and a host copy, the teams' blocks (watched
-  // first) and the columns' addresses.
+  // rows (output, block, width), their merged sums (output, width) and a host copy, each in two halves (a segment's
+  // sums go to one while the host reads the segment before's from the other), the teams' blocks (watched first) and
+  // the columns' addresses.
   Kokkos::View<double*, MemSpace> team_rows_;
   Kokkos::View<double**, Kokkos::LayoutRight, MemSpace> team_sums_;
   Kokkos::View<double**, Kokkos::LayoutRight, typename HostStaging<MemSpace>::space> team_sums_host_;
+  int team_sums_half_ = 0;  // the half the next segment's sums go to
   Kokkos::View<int*, MemSpace> team_blocks_;
   std::vector<int> team_block_order_;
   DeviceAddresses<MemSpace> team_columns_;
@@ -619,15 +636,40 @@ std::vector<FilterSnapshot> FilterBank<ExecSpace, Model, TruthModel>::snapshots_
 }
 
 template <class ExecSpace, class Model, class TruthModel>
-std::vector<std::vector<FilterSnapshot>> FilterBank<ExecSpace, Model, TruthModel>::step_segment(
-    const long k, const double dt, const std::vector<char>& outputs, const std::vector<std::string>& names,
-    const std::vector<long>& watched, const std::function<void(int)>& at_output) {
-  KUSHNER_REQUIRE(steps_in_segments(), "step_segment: estimators step beside the bank");
+void FilterBank<ExecSpace, Model, TruthModel>::start_segment(const long k, const double dt,
+                                                             const std::vector<char>& outputs,
+                                                             const std::vector<std::string>& names,
+                                                             const std::vector<long>& watched,
+                                                             const std::function<void(int)>& at_output) {
+  KUSHNER_REQUIRE(steps_in_segments(), "start_segment: estimators step beside the bank");
+  KUSHNER_REQUIRE(pending_segments_.size() < 2, "start_segment: two segments started and not finished");
   const SegmentPlan plan = plan_segment(outputs, names, watched);
-  const std::vector<MergedBlocks> merged =
-      segment_teams_ ? step_team_segment(k, dt, plan, at_output) : step_host_segment(k, dt, plan, at_output);
+  PendingSegment pending;
+  pending.names = names;
+  pending.first = plan.first;
+  pending.num_outputs = plan.num_outputs;
+  pending.num_columns = plan.num_columns;
+  pending.num_counted = plan.counted.columns();
+  if (segment_teams_)
+    step_team_segment(k, dt, plan, at_output, pending);
+  else
+    step_host_segment(k, dt, plan, at_output, pending);
+  pending_segments_.push_back(std::move(pending));
+}
+
+template <class ExecSpace, class Model, class TruthModel>
+std::vector<std::vector<FilterSnapshot>> FilterBank<ExecSpace, Model, TruthModel>::finish_segment() {
+  KUSHNER_REQUIRE(!pending_segments_.empty(), "finish_segment: no segment started");
+  PendingSegment pending = std::move(pending_segments_.front());
+  pending_segments_.erase(pending_segments_.begin());
+  if (pending.sums.data() != nullptr) {
+    pending.copied.wait();
+    for (int o = 0; o < pending.num_outputs; ++o)
+      pending.merged.push_back(merged_blocks(&pending.sums(o, 0), pending.num_columns, pending.num_counted, members_));
+  }
   std::vector<std::vector<FilterSnapshot>> result;
-  for (const MergedBlocks& output : merged) result.push_back(snapshots_of(output, names, plan.first));
+  for (const MergedBlocks& output : pending.merged)
+    result.push_back(snapshots_of(output, pending.names, pending.first));
   return result;
 }
 
@@ -666,7 +708,7 @@ typename FilterBank<ExecSpace, Model, TruthModel>::SegmentPlan FilterBank<ExecSp
   plan.width = 3 * plan.num_columns + plan.counted.columns();
   plan.num_blocks = static_cast<int>(moment_blocks(members_));
   for (const long member : watched) {
-    KUSHNER_REQUIRE(member >= 0 && member < members_, "step_segment: watched member " << member << " not in the bank");
+    KUSHNER_REQUIRE(member >= 0 && member < members_, "start_segment: watched member " << member << " not in the bank");
     plan.watched_blocks.push_back(static_cast<int>(member / moment_block_size));
   }
   std::sort(plan.watched_blocks.begin(), plan.watched_blocks.end());
@@ -676,9 +718,9 @@ typename FilterBank<ExecSpace, Model, TruthModel>::SegmentPlan FilterBank<ExecSp
 }
 
 template <class ExecSpace, class Model, class TruthModel>
-std::vector<MergedBlocks> FilterBank<ExecSpace, Model, TruthModel>::step_host_segment(
-    const long k, const double dt, const SegmentPlan& plan, const std::function<void(int)>& at_output) {
-  std::vector<MergedBlocks> merged;
+void FilterBank<ExecSpace, Model, TruthModel>::step_host_segment(const long k, const double dt, const SegmentPlan& plan,
+                                                                 const std::function<void(int)>& at_output,
+                                                                 PendingSegment& pending) {
   if constexpr (host_bank) {
     const int steps = static_cast<int>(plan.output_of.size());
     const std::size_t output_size = static_cast<std::size_t>(plan.num_blocks) * plan.width;
@@ -710,18 +752,18 @@ std::vector<MergedBlocks> FilterBank<ExecSpace, Model, TruthModel>::step_host_se
                          Kokkos::RangePolicy<ExecSpace, Kokkos::Schedule<Kokkos::Dynamic>>(space_, 0, plan.num_blocks),
                          segment);
     space_.fence();
-    merged = merge_segment_rows(segment_rows_.data(), plan);
+    pending.merged = merge_segment_rows(segment_rows_.data(), plan);
   }
-  return merged;
 }
 
 template <class ExecSpace, class Model, class TruthModel>
-std::vector<MergedBlocks> FilterBank<ExecSpace, Model, TruthModel>::step_team_segment(
-    const long k, const double dt, const SegmentPlan& plan, const std::function<void(int)>& at_output) {
+void FilterBank<ExecSpace, Model, TruthModel>::step_team_segment(const long k, const double dt, const SegmentPlan& plan,
+                                                                 const std::function<void(int)>& at_output,
+                                                                 PendingSegment& pending) {
   using Segment = FilterBankTeamSegment<typename K::Step, NotOkMembers<MemSpace>, MemSpace>;
   const int steps = static_cast<int>(plan.output_of.size());
   KUSHNER_REQUIRE(steps <= team_segment_max_steps,
-                  "step_segment: " << steps << " steps, more than a segment's " << team_segment_max_steps);
+                  "start_segment: " << steps << " steps, more than a segment's " << team_segment_max_steps);
   const int num_outputs = plan.num_outputs, width = plan.width, num_blocks = plan.num_blocks;
   const std::size_t output_size = static_cast<std::size_t>(num_blocks) * width;
   if (team_rows_.extent(0) < output_size * num_outputs)
@@ -768,7 +810,7 @@ std::vector<MergedBlocks> FilterBank<ExecSpace, Model, TruthModel>::step_team_se
       const double* const squared_error = slot.snapshot.data() + snapshot_squared_error * slot.snapshot.stride(1);
       for (int c = 0; c + 1 < plan.num_columns; ++c)
         if (plan.columns[c].column == squared_error && plan.columns[c].sink >= 0) {
-          KUSHNER_REQUIRE(c + 1 < 64, "step_segment: " << plan.num_columns << " columns, more than a sink's 64");
+          KUSHNER_REQUIRE(c + 1 < 64, "start_segment: " << plan.num_columns << " columns, more than a sink's 64");
           slot.team_sink = c * moment_block_size;
           segment.sink_mask |= std::uint64_t{3} << c;
         }
@@ -814,7 +856,7 @@ std::vector<MergedBlocks> FilterBank<ExecSpace, Model, TruthModel>::step_team_se
               Kokkos::Impl::CudaParallelLaunch<Driver, typename Policy::launch_bounds>::get_kernel_func();
           KUSHNER_REQUIRE(
               cudaFuncSetAttribute(kernel, cudaFuncAttributePreferredSharedMemoryCarveout, percent) == cudaSuccess,
-              "step_segment: cudaFuncSetAttribute (shared memory carveout) failed");
+              "start_segment: cudaFuncSetAttribute (shared memory carveout) failed");
           carveout = percent;
         }
       }
@@ -836,27 +878,31 @@ std::vector<MergedBlocks> FilterBank<ExecSpace, Model, TruthModel>::step_team_se
   segment.last_output = plan.last_output;
   launch(watched, num_blocks - watched);
 
-  std::vector<MergedBlocks> merged;
-  if (num_outputs == 0) return merged;
-  const int num_counted = plan.counted.columns();
+  if (num_outputs == 0) return;
   if (collective::ranks() > 1) {  // every rank's rows, gathered in rank order (the same branch on every rank)
     const auto rows = Kokkos::create_mirror_view_and_copy(
         Kokkos::HostSpace(), Kokkos::subview(team_rows_, std::make_pair(std::size_t(0), output_size * num_outputs)));
-    return merge_segment_rows(rows.data(), plan);
+    pending.merged = merge_segment_rows(rows.data(), plan);
+    return;
   }
-  if (team_sums_.extent(1) != static_cast<std::size_t>(width)) {  // room for a segment's every step an output
+  if (team_sums_.extent(1) != static_cast<std::size_t>(width)) {  // room for two segments' every step an output
+    // (A segment still waiting to be finished keeps its half of the old host copy: PendingSegment::sums.)
     team_sums_ = Kokkos::View<double**, Kokkos::LayoutRight, MemSpace>(
-        Kokkos::view_alloc(space_, Kokkos::WithoutInitializing, "kushner::segment_sums"), team_segment_max_steps,
+        Kokkos::view_alloc(space_, Kokkos::WithoutInitializing, "kushner::segment_sums"), 2 * team_segment_max_steps,
         width);
     team_sums_host_ = Kokkos::create_mirror_view(typename HostStaging<MemSpace>::space(), team_sums_);
   }
-  merge_block_rows(space_, MergeBlockRows<MemSpace>{team_rows_, num_blocks, plan.num_columns, num_counted, team_sums_},
+  const auto half =
+      std::make_pair(team_sums_half_ * team_segment_max_steps, (team_sums_half_ + 1) * team_segment_max_steps);
+  team_sums_half_ = 1 - team_sums_half_;
+  const auto sums = Kokkos::subview(team_sums_, half, Kokkos::ALL);
+  merge_block_rows(space_,
+                   MergeBlockRows<MemSpace>{team_rows_, num_blocks, plan.num_columns, plan.counted.columns(), sums},
                    num_outputs);
-  if (team_sums_host_.data() != team_sums_.data()) Kokkos::deep_copy(space_, team_sums_host_, team_sums_);
-  space_.fence();
-  for (int o = 0; o < num_outputs; ++o)
-    merged.push_back(merged_blocks(team_sums_host_.data() + o * width, plan.num_columns, num_counted, members_));
-  return merged;
+  const auto host_sums = Kokkos::subview(team_sums_host_, half, Kokkos::ALL);
+  if (team_sums_host_.data() != team_sums_.data()) Kokkos::deep_copy(space_, host_sums, sums);
+  pending.sums = host_sums;
+  pending.copied.record(space_);
 }
 
 template <class ExecSpace, class Model, class TruthModel>

@@ -48,7 +48,7 @@ struct FilterReport {
 
 /// `observe` is called at t = 0 and at every output time with the bank and the outside estimators (PF, EXACT), e.g.
 /// to record chosen members' trajectories. It may read the global members `members` only: a run without outside
-/// estimators takes several steps at a time (FilterBank::step_segment), and at an output time only those are there.
+/// estimators takes several steps at a time (FilterBank::start_segment), and at an output time only those are there.
 template <class ExecSpace, class Model, class TruthModel = Model>
 struct OutputObserver {
   std::function<void(double t, const FilterBank<ExecSpace, Model, TruthModel>&,
@@ -179,7 +179,8 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
     outside_view.push_back(e.get());
   }
   // An output time's metrics are queued when the bank reaches it and collected once the next step is queued (or
-  // before a checkpoint, or at the end): on a GPU the host merges them while the device takes that step.
+  // before a checkpoint, or at the end): on a GPU the host merges them while the device takes that step. A segment's
+  // likewise, once the next segment is queued (FilterBank::start_segment).
   bool collecting = false;
   const auto record = [&](double t) {
     report.times.push_back(t);
@@ -187,9 +188,25 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
     collecting = true;
     if (observer.observe) observer.observe(t, bank, outside_view);
   };
+  struct StartedSegment {
+    long k;
+    std::vector<char> outputs;
+  };
+  std::vector<StartedSegment> started_segments;  // oldest first
+  const auto collect_segment = [&] {
+    const StartedSegment segment = started_segments.front();
+    started_segments.erase(started_segments.begin());
+    const auto series = bank.finish_segment();
+    for (long s = 0, o = 0; s < static_cast<long>(segment.outputs.size()); ++s)
+      if (segment.outputs[s]) {
+        report.times.push_back((segment.k + s + 1) * grid.dt);
+        report.series.push_back(series[o++]);
+      }
+  };
   const auto collect = [&] {
     if (collecting) report.series.push_back(bank.finish_snapshots());
     collecting = false;
+    while (!started_segments.empty()) collect_segment();
   };
   // Everything that carries from one step to the next, in a fixed order; `step`: the steps taken.
   const auto visit_run_state = [&](StateArchive& archive, long& step) {
@@ -238,7 +255,7 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
   const auto ends_at_output = [&](long step) {
     return next_output < grid.output_steps.size() && grid.output_steps[next_output] == step;
   };
-  // Several steps at a time where nothing steps beside the bank (FilterBank::step_segment): on the host they doubled
+  // Several steps at a time where nothing steps beside the bank (FilterBank::start_segment): on the host they doubled
   // the bank's rate, on a GPU 1.7-1.8x (perf/filter_bank.md). The same on every rank (the total member count), as
   // every rank must make the same collective calls.
   const bool segments = bank.steps_in_segments() && share.total >= segment_min_members;
@@ -246,22 +263,21 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
   for (const long member : observer.members)
     if (share.holds(member)) watched.push_back(member - share.first);
   const auto take_segment = [&](const long k) {
-    collect();
+    if (collecting) {  // the output at t = 0 (or the last step-at-a-time one)
+      report.series.push_back(bank.finish_snapshots());
+      collecting = false;
+    }
     const long steps = std::min<long>(FilterBank<ExecSpace, Model, TruthModel>::segment_steps, grid.steps - k);
     std::vector<char> outputs(steps, 0);
-    for (std::size_t s = 0, o = next_output; s < outputs.size(); ++s) {
-      outputs[s] = o < grid.output_steps.size() && grid.output_steps[o] == k + static_cast<long>(s) + 1;
-      if (outputs[s]) ++o;
+    for (std::size_t s = 0; s < outputs.size(); ++s) {
+      outputs[s] = ends_at_output(k + static_cast<long>(s) + 1);
+      if (outputs[s]) ++next_output;
     }
-    const auto series = bank.step_segment(k, grid.dt, outputs, report.filters, watched, [&](int s) {
+    bank.start_segment(k, grid.dt, outputs, report.filters, watched, [&](int s) {
       if (observer.observe) observer.observe((k + s + 1) * grid.dt, bank, outside_view);
     });
-    for (long s = 0, o = 0; s < steps; ++s)
-      if (outputs[s]) {
-        report.times.push_back((k + s + 1) * grid.dt);
-        report.series.push_back(series[o++]);
-        ++next_output;
-      }
+    started_segments.push_back({k, std::move(outputs)});
+    if (started_segments.size() > 1) collect_segment();  // the one before: merged while this one runs
     return k + steps;
   };
   for (long k = first_step; k < grid.steps;) {

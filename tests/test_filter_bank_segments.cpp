@@ -1,4 +1,4 @@
-// FilterBank::step_segment (a host bank's steps taken several at a time, each block of members through all of them:
+// FilterBank::start_segment (a host bank's steps taken several at a time, each block of members through all of them:
 // kernels/filters/filter_bank_segment.hpp) against the same bank stepped one step at a time: the snapshots of every
 // output step, the watched members at each output time, and all the bank holds at the end (truths, each filter's m,
 // P, status, score sums and snapshot columns) are the same bits. For sine with every filter it supports (lanes that
@@ -116,18 +116,25 @@ void expect_segments_match_steps(const Model& model, const std::vector<std::stri
   }
   ASSERT_EQ(step_snapshots.size(), output_ends.size());
 
+  // As run_filters takes them: a segment finished once the next one is started (its outputs' sums then in the other
+  // half of the team form's buffers).
   std::vector<std::vector<FilterSnapshot>> segment_snapshots;
   std::vector<std::vector<double>> segment_watched;
+  const auto finish_segment = [&] {
+    const auto snapshots = segmented.finish_segment();
+    segment_snapshots.insert(segment_snapshots.end(), snapshots.begin(), snapshots.end());
+  };
   long k = 0;
   for (const int size : segments) {
     std::vector<char> outputs(size);
     for (int s = 0; s < size; ++s) outputs[s] = is_output(k + s + 1) ? 1 : 0;
-    const auto snapshots = segmented.step_segment(k, dt, outputs, filters, watched, [&](int) {
+    segmented.start_segment(k, dt, outputs, filters, watched, [&](int) {
       for (const long member : watched) segment_watched.push_back(member_values(segmented, filters, member));
     });
-    segment_snapshots.insert(segment_snapshots.end(), snapshots.begin(), snapshots.end());
+    if (k > 0) finish_segment();
     k += size;
   }
+  finish_segment();
   ASSERT_EQ(segment_snapshots.size(), step_snapshots.size());
   for (std::size_t o = 0; o < step_snapshots.size(); ++o)
     expect_same_snapshots(step_snapshots[o], segment_snapshots[o], "output at step " + std::to_string(output_ends[o]),
