@@ -37,31 +37,18 @@ struct PendulumModel : InitialLaw<2> {
   KOKKOS_INLINE_FUNCTION Vec<2> drift(double, const Vec<2>& x, const Control&) const {
     return {{x[1], -g * math::sin(x[0])}};
   }
-  // The cosines apart from the sines (math::cos_apart_from_sin, the same bits): GCC fuses a sin and a cos of one x
-  // into sincos, which has no vector version, and a host bank's filters take them in SIMD lanes.
   KOKKOS_INLINE_FUNCTION Mat<2, 2> drift_jacobian(double, const Vec<2>& x, const Control&) const {
-    return {{{0.0, 1.0}, {-g * math::cos_apart_from_sin(x[0]), 0.0}}};
+    return {{{0.0, 1.0}, {-g * math::cos(x[0]), 0.0}}};
   }
-  /// drift and drift_jacobian, the same bits, with one range reduction for the sine and cosine on a GPU.
-  KOKKOS_INLINE_FUNCTION DriftAndJacobian<2> drift_and_jacobian(double, const Vec<2>& x, const Control&) const {
-    double s, c;
-    math::sin_cos(x[0], s, c);
-    return {{{x[1], -g * s}}, {{{0.0, 1.0}, {-g * c, 0.0}}}};
-  }
-  /// Its sine by sin_cos: the SOF asks for it where it asked drift_and_jacobian, and nvcc computes the same call once.
   KOKKOS_INLINE_FUNCTION Mat<2, 2> drift_hessian(double, const Vec<2>& x, const Control&, int k) const {
     Mat<2, 2> h = Mat<2, 2>::zero();
-    if (k == 1) {
-      double s, c;
-      math::sin_cos(x[0], s, c);
-      h(0, 0) = g * s;
-    }
+    if (k == 1) h(0, 0) = g * math::sin(x[0]);
     return h;
   }
   KOKKOS_INLINE_FUNCTION Mat<2, 1> diffusion(double, const Vec<2>&) const { return {{{0.0}, {q}}}; }
   KOKKOS_INLINE_FUNCTION Vec<1> observation(double, const Vec<2>& x) const { return {{math::sin(x[0])}}; }
   KOKKOS_INLINE_FUNCTION Mat<1, 2> observation_jacobian(double, const Vec<2>& x) const {
-    return {{{math::cos_apart_from_sin(x[0]), 0.0}}};
+    return {{{math::cos(x[0]), 0.0}}};
   }
   KOKKOS_INLINE_FUNCTION Mat<2, 2> observation_hessian(double, const Vec<2>& x, int) const {
     return {{{-math::sin(x[0]), 0.0}, {0.0, 0.0}}};
@@ -71,16 +58,12 @@ struct PendulumModel : InitialLaw<2> {
   /// E[sin x1] = sin(m1) e^{-p11/2}, E[cos x1] = cos(m1) e^{-p11/2} for x ~ N(m, P) (as seed 000 (6.4)-(6.5)).
   KOKKOS_INLINE_FUNCTION GaussianDrift<2> gaussian_drift(double, const Vec<2>& m, const Mat<2, 2>& P) const {
     const double damping = math::exp(-0.5 * P(0, 0));
-    double s, c;
-    math::sin_cos(m[0], s, c);
-    return {{{m[1], -g * s * damping}}, {{{0.0, 1.0}, {-g * c * damping, 0.0}}}};
+    return {{{m[1], -g * math::sin(m[0]) * damping}}, {{{0.0, 1.0}, {-g * math::cos(m[0]) * damping, 0.0}}}};
   }
   KOKKOS_INLINE_FUNCTION GaussianObservation<2, 1> gaussian_observation(double, const Vec<2>& m,
                                                                         const Mat<2, 2>& P) const {
     const double damping = math::exp(-0.5 * P(0, 0));
-    double s, c;
-    math::sin_cos(m[0], s, c);
-    return {{{s * damping}}, {{{c * damping, 0.0}}}};
+    return {{{math::sin(m[0]) * damping}}, {{{math::cos(m[0]) * damping, 0.0}}}};
   }
   /// sin x1 = sinc(x1) x1: A(x) = [[0, 1], [-g sinc x1, 0]], C(x) = [sinc x1, 0] (ASRE, seed 001 (4)-(5)).
   KOKKOS_INLINE_FUNCTION static double sinc(double v) {
