@@ -203,9 +203,12 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
         report.series.push_back(series[o++]);
       }
   };
-  const auto collect = [&] {
+  const auto collect_step = [&] {
     if (collecting) report.series.push_back(bank.finish_snapshots());
     collecting = false;
+  };
+  const auto collect = [&] {
+    collect_step();
     while (!started_segments.empty()) collect_segment();
   };
   // Everything that carries from one step to the next, in a fixed order; `step`: the steps taken.
@@ -263,10 +266,7 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
   for (const long member : observer.members)
     if (share.holds(member)) watched.push_back(member - share.first);
   const auto take_segment = [&](const long k) {
-    if (collecting) {  // the output at t = 0 (or the last step-at-a-time one)
-      report.series.push_back(bank.finish_snapshots());
-      collecting = false;
-    }
+    collect_step();  // the output at t = 0
     const long steps = std::min<long>(FilterBank<ExecSpace, Model, TruthModel>::segment_steps, grid.steps - k);
     std::vector<char> outputs(steps, 0);
     for (std::size_t s = 0; s < outputs.size(); ++s) {
