@@ -246,7 +246,8 @@ nlohmann::json run_compare_with_truth(const TruthModel& truth_model, const Model
     TrajectoryRecorder<ExecSpace, Model> recorder(options.trajectory_members, options.run.members, density_times);
     Progress progress(options.plots ? "compare" : "filter", progress_steps<Model>(filters, grid), !options.run.quiet);
     OutputObserver<ExecSpace, Model, TruthModel> observer;
-    if (!options.trajectory_members.empty()) observer = {std::ref(recorder), recorder.members_read()};
+    if (!options.trajectory_members.empty())
+      observer = {std::ref(recorder), [&](const auto& bank) { return recorder.elements(bank); }};
     RunCheckpointing checkpointing;
     const std::string identity =
         options.checkpoints ? detail::run_identity(model, options, filters, particle, density_times, grid) : "";

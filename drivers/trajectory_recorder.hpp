@@ -57,9 +57,11 @@ class TrajectoryRecorder {
     trajectories_ = "member,t,component,series,estimate,lower,upper\n";
   }
 
+  /// Records output time t. `values`: null, or the values at t of elements(bank) (engine/filter_run.hpp's
+  /// OutputObserver: a run without outside estimators, whose bank may be further on).
   template <class TruthModel>
   void operator()(double t, const FilterBank<ExecSpace, Model, TruthModel>& bank,
-                  const std::vector<const ReferenceEstimator<MemSpace>*>& outside) {
+                  const std::vector<const ReferenceEstimator<MemSpace>*>& outside, const std::vector<double>* values) {
     if (members_.empty()) return;
     std::vector<int> local;  // the chosen and scanned members this rank holds, as indices into its bank
     for (long m : members_)
@@ -76,11 +78,16 @@ class TrajectoryRecorder {
       if (snapshot) pf = e;
     }
     const bool density = pf && next_density_ < density_times_.size() && t >= density_times_[next_density_] - 1e-9;
-    std::vector<std::uintptr_t> addresses;  // first pass: what the rows read; then one gather; then the rows
-    ElementReader record{&addresses};
-    for (long member : members_)
-      if (share_.holds(member)) trajectory_rows(t, member, member - share_.first, bank, outside, pf, snapshot, record);
-    ElementReader read{nullptr, &gather_(ExecSpace(), addresses)};
+    // First pass: what the rows read; then one gather (unless the values came with the call); then the rows.
+    const std::vector<WatchedElement> read_elements = elements(bank, outside, pf);
+    if (values == nullptr) {
+      std::vector<std::uintptr_t> addresses;
+      for (const WatchedElement& e : read_elements) addresses.push_back(e.address);
+      values = &gather_(ExecSpace(), addresses);
+    }
+    KUSHNER_REQUIRE(values->size() == read_elements.size(),
+                    "TrajectoryRecorder: " << values->size() << " values for " << read_elements.size() << " elements");
+    ElementReader read{nullptr, values};
     for (long member : members_) {
       std::string rows;
       if (share_.holds(member))
@@ -123,11 +130,10 @@ class TrajectoryRecorder {
     }
   }
 
-  /// The (global) members operator() reads: the chosen ones and the scanned ones.
-  std::vector<long> members_read() const {
-    std::vector<long> read = members_;
-    for (long m = 0; m < bimodal_.scanned_members; ++m) read.push_back(m);
-    return read;
+  /// The elements of this rank's bank operator() reads at every output time of a run without outside estimators.
+  template <class TruthModel>
+  std::vector<WatchedElement> elements(const FilterBank<ExecSpace, Model, TruthModel>& bank) const {
+    return elements(bank, {}, nullptr);
   }
 
   const std::string& trajectories_csv() const { return trajectories_; }
@@ -150,6 +156,18 @@ class TrajectoryRecorder {
   }
 
  private:
+  /// The elements the rows of this rank's chosen members read (trajectory_rows' first pass), in their order.
+  template <class TruthModel>
+  std::vector<WatchedElement> elements(const FilterBank<ExecSpace, Model, TruthModel>& bank,
+                                       const std::vector<const ReferenceEstimator<MemSpace>*>& outside,
+                                       const ReferenceEstimator<MemSpace>* pf) const {
+    std::vector<WatchedElement> read;
+    ElementReader record{&read};
+    for (long member : members_)
+      if (share_.holds(member)) trajectory_rows(0.0, member, member - share_.first, bank, outside, pf, {}, record);
+    return read;
+  }
+
   template <class View>
   static auto row(const View& v, long member) {
     return host_copy(Kokkos::subview(v, member, Kokkos::ALL));
@@ -158,13 +176,13 @@ class TrajectoryRecorder {
   /// How trajectory_rows reads element (row `local`, column) of a bank view: a first pass records where
   /// (`record`), ElementGather copies all of them at once, and a second pass reads the values in the same order.
   struct ElementReader {
-    std::vector<std::uintptr_t>* record = nullptr;
+    std::vector<WatchedElement>* record = nullptr;
     const std::vector<double>* values = nullptr;
     std::size_t next = 0;
     template <class View>
     double operator()(const View& v, long local, int column) {
       if (record == nullptr) return (*values)[next++];
-      record->push_back(element_address(v, local, column));
+      record->push_back({element_address(v, local, column), local});
       return 0.0;
     }
   };

@@ -212,17 +212,22 @@ class FilterBank {
   /// Queues steps k .. k + outputs.size() - 1 in one pass over blocks of members (temporal blocking:
   /// kernels/filters/filter_bank_segment.hpp), with the numbers of step() one step at a time (steps_in_segments();
   /// on a GPU up to the multiply-adds nvcc contracts; at most team_segment_max_steps steps in the team form).
-  /// outputs[s] != 0: step k + s ends at an output time. The members `watched` (indices into this bank) take the steps
-  /// one at a time first, and after each output step at_output(s) is called with them there: every other member is
-  /// then at the segment's start, so at_output may read only the watched ones. finish_segment waits for the oldest
-  /// started segment's outputs and returns snapshots(names) of each, in order (a collective call over the ranks, as
-  /// finish_snapshots is). A second segment may be started before the first is finished: engine/filter_run.hpp queues
-  /// the next segment first, so that on a GPU the host merges one segment's outputs while the device takes the next
-  /// (waiting for them at once left the device idle meanwhile). Where a segment's outputs are merged as it is taken
-  /// (the host's forms, several ranks), start_segment waits for them.
+  /// outputs[s] != 0: step k + s ends at an output time. finish_segment waits for the oldest started segment's outputs
+  /// and returns, for each in order, snapshots(names) and the values of the `watched` elements (element_address of
+  /// this bank's views, members indexed in this bank) at its time: each block copies its own elements as it takes
+  /// the output step (an observer of a few members read them between steps taken one at a time by their block first,
+  /// a launch and a wait per step: 0.72-0.77x the rate of the bank unwatched on an H200). finish_segment is a
+  /// collective call over the ranks, as finish_snapshots is. A second segment may be started before the first is
+  /// finished: engine/filter_run.hpp queues the next segment first, so that on a GPU the host merges one segment's
+  /// outputs while the device takes the next (waiting for them at once left the device idle meanwhile). Where a
+  /// segment's outputs are merged as it is taken (the host's forms, several ranks), start_segment waits for them.
   void start_segment(long k, double dt, const std::vector<char>& outputs, const std::vector<std::string>& names,
-                     const std::vector<long>& watched = {}, const std::function<void(int)>& at_output = {});
-  std::vector<std::vector<FilterSnapshot>> finish_segment();
+                     const std::vector<WatchedElement>& watched = {});
+  struct SegmentOutput {
+    std::vector<FilterSnapshot> snapshots;
+    std::vector<double> watched;
+  };
+  std::vector<SegmentOutput> finish_segment();
 
   const TruthBank<ExecSpace, TruthModel>& truths() const { return truths_; }
   /// (member): non_finite once the member's truth escaped to infinity.
@@ -448,7 +453,7 @@ class FilterBank {
   };
   mutable PendingSnapshots pending_;
   /// What both forms of start_segment need: per step its output's index (or -1), the snapshot columns of `names`
-  /// (host form: with their places in the sink), their divergence counts, the blocks of the watched members.
+  /// (host form: with their places in the sink), their divergence counts, the watched elements (values not set).
   struct SegmentPlan {
     std::vector<int> output_of;
     int num_outputs = 0, last_output = -1;
@@ -456,10 +461,10 @@ class FilterBank {
     std::vector<int> first;  // names[i]'s first column
     NotOkMembers<MemSpace> counted;
     int num_columns = 0, width = 0, num_blocks = 0;
-    std::vector<int> watched_blocks;  // in increasing order
+    WatchedElements<MemSpace> watched;
   };
   SegmentPlan plan_segment(const std::vector<char>& outputs, const std::vector<std::string>& names,
-                           const std::vector<long>& watched);
+                           const std::vector<WatchedElement>& watched);
   /// Each of plan's outputs' rows (host memory: output, block, width) merged over every rank
   /// (merge_block_statistics; a collective call).
   std::vector<MergedBlocks> merge_segment_rows(const double* rows, const SegmentPlan& plan) const {
@@ -470,35 +475,35 @@ class FilterBank {
                                               plan.counted.columns(), members_));
     return merged;
   }
-  /// A started segment's outputs: merged already, or on their way to `sums` (rows (output, width), host memory).
+  /// A started segment's outputs: merged already (with the watched values), or on their way to `sums` (rows (output,
+  /// width + watched elements), host memory: the team form; on several ranks only its watched values).
   struct PendingSegment {
     std::vector<std::string> names;
     std::vector<int> first;
-    int num_outputs = 0, num_columns = 0, num_counted = 0;
+    int num_outputs = 0, num_columns = 0, num_counted = 0, num_watched = 0;
     std::vector<MergedBlocks> merged;
+    std::vector<std::vector<double>> watched;
     Kokkos::View<const double**, Kokkos::LayoutRight, typename HostStaging<MemSpace>::space> sums;
     QueueMark<ExecSpace> copied;  // after the copy to `sums`
   };
   std::vector<PendingSegment> pending_segments_;  // oldest first, at most two (team_sums_' two halves)
-  /// start_segment's forms: they step the bank and leave each output's merged moments in `pending` (the team form on
-  /// one process: their sums on the way to the host).
-  void step_host_segment(long k, double dt, const SegmentPlan& plan, const std::function<void(int)>& at_output,
-                         PendingSegment& pending);
-  void step_team_segment(long k, double dt, const SegmentPlan& plan, const std::function<void(int)>& at_output,
-                         PendingSegment& pending);
+  /// start_segment's forms: they step the bank and leave each output's merged moments and watched values in
+  /// `pending` (the team form: on their way to the host, the moments merged there on several ranks).
+  void step_host_segment(long k, double dt, const SegmentPlan& plan, PendingSegment& pending);
+  void step_team_segment(long k, double dt, SegmentPlan plan, PendingSegment& pending);
 
   bool segment_teams_ = !host_bank;
-  std::vector<double> segment_rows_;  // the host form's block statistics, kept from one segment to the next
+  std::vector<double> segment_rows_;        // the host form's block statistics, kept from one segment to the next
+  DeviceAddresses<MemSpace> watched_list_;  // WatchedElements::list, uploaded when it changes
   // The team form's buffers, kept from one segment to the next (on a GPU an allocation waits for the device): the
-  // rows (output, block, width), their merged sums (output, width) and a host copy, each in two halves (a segment's
-  // sums go to one while the host reads the segment before's from the other), the teams' blocks (watched first) and
-  // the columns' addresses.
+  // rows (output, block, width), their merged sums with the watched values (output, width + watched) and a host copy,
+  // each in two halves (a segment's sums go to one while the host reads the segment before's from the other) with a
+  // mark after each half's copy, and the columns' addresses.
   Kokkos::View<double*, MemSpace> team_rows_;
   Kokkos::View<double**, Kokkos::LayoutRight, MemSpace> team_sums_;
   Kokkos::View<double**, Kokkos::LayoutRight, typename HostStaging<MemSpace>::space> team_sums_host_;
+  QueueMark<ExecSpace> team_sums_copied_[2];
   int team_sums_half_ = 0;  // the half the next segment's sums go to
-  Kokkos::View<int*, MemSpace> team_blocks_;
-  std::vector<int> team_block_order_;
   DeviceAddresses<MemSpace> team_columns_;
 };
 
@@ -639,8 +644,7 @@ template <class ExecSpace, class Model, class TruthModel>
 void FilterBank<ExecSpace, Model, TruthModel>::start_segment(const long k, const double dt,
                                                              const std::vector<char>& outputs,
                                                              const std::vector<std::string>& names,
-                                                             const std::vector<long>& watched,
-                                                             const std::function<void(int)>& at_output) {
+                                                             const std::vector<WatchedElement>& watched) {
   KUSHNER_REQUIRE(steps_in_segments(), "start_segment: estimators step beside the bank");
   KUSHNER_REQUIRE(pending_segments_.size() < 2, "start_segment: two segments started and not finished");
   const SegmentPlan plan = plan_segment(outputs, names, watched);
@@ -650,32 +654,40 @@ void FilterBank<ExecSpace, Model, TruthModel>::start_segment(const long k, const
   pending.num_outputs = plan.num_outputs;
   pending.num_columns = plan.num_columns;
   pending.num_counted = plan.counted.columns();
+  pending.num_watched = plan.watched.count;
   if (segment_teams_)
-    step_team_segment(k, dt, plan, at_output, pending);
+    step_team_segment(k, dt, plan, pending);
   else
-    step_host_segment(k, dt, plan, at_output, pending);
+    step_host_segment(k, dt, plan, pending);
   pending_segments_.push_back(std::move(pending));
 }
 
 template <class ExecSpace, class Model, class TruthModel>
-std::vector<std::vector<FilterSnapshot>> FilterBank<ExecSpace, Model, TruthModel>::finish_segment() {
+std::vector<typename FilterBank<ExecSpace, Model, TruthModel>::SegmentOutput>
+FilterBank<ExecSpace, Model, TruthModel>::finish_segment() {
   KUSHNER_REQUIRE(!pending_segments_.empty(), "finish_segment: no segment started");
   PendingSegment pending = std::move(pending_segments_.front());
   pending_segments_.erase(pending_segments_.begin());
   if (pending.sums.data() != nullptr) {
     pending.copied.wait();
-    for (int o = 0; o < pending.num_outputs; ++o)
-      pending.merged.push_back(merged_blocks(&pending.sums(o, 0), pending.num_columns, pending.num_counted, members_));
+    const bool merged = !pending.merged.empty();  // on several ranks, merged as the segment was taken
+    const int width = 3 * pending.num_columns + pending.num_counted;
+    for (int o = 0; o < pending.num_outputs; ++o) {
+      const double* const row = &pending.sums(o, 0);
+      if (!merged) pending.merged.push_back(merged_blocks(row, pending.num_columns, pending.num_counted, members_));
+      pending.watched.emplace_back(row + width, row + width + pending.num_watched);
+    }
   }
-  std::vector<std::vector<FilterSnapshot>> result;
-  for (const MergedBlocks& output : pending.merged)
-    result.push_back(snapshots_of(output, pending.names, pending.first));
+  std::vector<SegmentOutput> result;
+  for (int o = 0; o < pending.num_outputs; ++o)
+    result.push_back({snapshots_of(pending.merged[o], pending.names, pending.first), std::move(pending.watched[o])});
   return result;
 }
 
 template <class ExecSpace, class Model, class TruthModel>
 typename FilterBank<ExecSpace, Model, TruthModel>::SegmentPlan FilterBank<ExecSpace, Model, TruthModel>::plan_segment(
-    const std::vector<char>& outputs, const std::vector<std::string>& names, const std::vector<long>& watched) {
+    const std::vector<char>& outputs, const std::vector<std::string>& names,
+    const std::vector<WatchedElement>& watched) {
   using Step = typename K::Step;
   SegmentPlan plan;
   const int steps = static_cast<int>(outputs.size());
@@ -707,45 +719,39 @@ typename FilterBank<ExecSpace, Model, TruthModel>::SegmentPlan FilterBank<ExecSp
   plan.num_columns = static_cast<int>(plan.columns.size());
   plan.width = 3 * plan.num_columns + plan.counted.columns();
   plan.num_blocks = static_cast<int>(moment_blocks(members_));
-  for (const long member : watched) {
-    KUSHNER_REQUIRE(member >= 0 && member < members_, "start_segment: watched member " << member << " not in the bank");
-    plan.watched_blocks.push_back(static_cast<int>(member / moment_block_size));
-  }
-  std::sort(plan.watched_blocks.begin(), plan.watched_blocks.end());
-  plan.watched_blocks.erase(std::unique(plan.watched_blocks.begin(), plan.watched_blocks.end()),
-                            plan.watched_blocks.end());
+  for (const WatchedElement& e : watched)
+    KUSHNER_REQUIRE(e.member >= 0 && e.member < members_,
+                    "start_segment: watched member " << e.member << " not in the bank");
+  plan.watched.list = watched_list_.update(space_, WatchedElements<MemSpace>::list_of(watched));
+  plan.watched.count = static_cast<int>(watched.size());
   return plan;
 }
 
 template <class ExecSpace, class Model, class TruthModel>
 void FilterBank<ExecSpace, Model, TruthModel>::step_host_segment(const long k, const double dt, const SegmentPlan& plan,
-                                                                 const std::function<void(int)>& at_output,
                                                                  PendingSegment& pending) {
   if constexpr (host_bank) {
     const int steps = static_cast<int>(plan.output_of.size());
     const std::size_t output_size = static_cast<std::size_t>(plan.num_blocks) * plan.width;
     segment_rows_.resize(output_size * plan.num_outputs);
-    const FilterBankSegment<typename K::Step, NotOkMembers<MemSpace>> segment{
-        step_kernel(k, dt, false),
-        k,
-        steps,
-        dt,
-        plan.output_of.data(),
-        plan.last_output,
-        plan.columns.data(),
-        plan.num_columns,
-        plan.counted,
-        segment_rows_.data(),
-        plan.num_blocks,
-        plan.width,
-        static_cast<int>(members_),
-        plan.watched_blocks.data(),
-        static_cast<int>(plan.watched_blocks.size())};
+    WatchedElements<Kokkos::HostSpace> watched{plan.watched.list, plan.watched.count, {}, 0};
+    watched.values = Kokkos::View<double**, Kokkos::LayoutRight, Kokkos::HostSpace>(
+        Kokkos::view_alloc(Kokkos::WithoutInitializing, "kushner::segment_watched"), plan.num_outputs, watched.count);
+    const FilterBankSegment<typename K::Step, NotOkMembers<MemSpace>> segment{step_kernel(k, dt, false),
+                                                                              k,
+                                                                              steps,
+                                                                              dt,
+                                                                              plan.output_of.data(),
+                                                                              plan.last_output,
+                                                                              plan.columns.data(),
+                                                                              plan.num_columns,
+                                                                              plan.counted,
+                                                                              segment_rows_.data(),
+                                                                              plan.num_blocks,
+                                                                              plan.width,
+                                                                              static_cast<int>(members_),
+                                                                              watched};
     space_.fence();
-    for (int s = 0; s < steps; ++s) {
-      for (const int b : plan.watched_blocks) segment.run_block(b, s, s + 1);
-      if (plan.output_of[s] >= 0 && at_output) at_output(s);
-    }
     // Blocks handed out as threads free up: a thread slowed by anything else on its core no longer holds the others
     // at the end of the segment (the rows are merged in block order, so the bits do not depend on who ran what).
     Kokkos::parallel_for("kushner::filter_bank_segment",
@@ -753,12 +759,15 @@ void FilterBank<ExecSpace, Model, TruthModel>::step_host_segment(const long k, c
                          segment);
     space_.fence();
     pending.merged = merge_segment_rows(segment_rows_.data(), plan);
+    for (int o = 0; o < plan.num_outputs; ++o) {
+      const double* const values = watched.values.data() + static_cast<std::size_t>(o) * watched.count;
+      pending.watched.emplace_back(values, values + watched.count);
+    }
   }
 }
 
 template <class ExecSpace, class Model, class TruthModel>
-void FilterBank<ExecSpace, Model, TruthModel>::step_team_segment(const long k, const double dt, const SegmentPlan& plan,
-                                                                 const std::function<void(int)>& at_output,
+void FilterBank<ExecSpace, Model, TruthModel>::step_team_segment(const long k, const double dt, SegmentPlan plan,
                                                                  PendingSegment& pending) {
   using Segment = FilterBankTeamSegment<typename K::Step, NotOkMembers<MemSpace>, MemSpace>;
   const int steps = static_cast<int>(plan.output_of.size());
@@ -769,28 +778,30 @@ void FilterBank<ExecSpace, Model, TruthModel>::step_team_segment(const long k, c
   if (team_rows_.extent(0) < output_size * num_outputs)
     team_rows_ = Kokkos::View<double*, MemSpace>(
         Kokkos::view_alloc(space_, Kokkos::WithoutInitializing, "kushner::segment_rows"), output_size * num_outputs);
-  // The teams' blocks: the watched ones first (they take the steps one at a time), then the others.
-  std::vector<int> order = plan.watched_blocks;
-  for (int b = 0; b < num_blocks; ++b)
-    if (!std::binary_search(plan.watched_blocks.begin(), plan.watched_blocks.end(), b)) order.push_back(b);
-  if (order != team_block_order_) {
-    team_blocks_ = Kokkos::View<int*, MemSpace>(
-        Kokkos::view_alloc(space_, Kokkos::WithoutInitializing, "kushner::segment_blocks"), order.size());
-    Kokkos::deep_copy(space_, team_blocks_,
-                      Kokkos::View<const int*, Kokkos::HostSpace, Kokkos::MemoryTraits<Kokkos::Unmanaged>>(
-                          order.data(), order.size()));
-    space_.fence();  // the copy reads `order`
-    team_block_order_ = order;
+  // The outputs' merged sums and watched values: to one half of team_sums_ (room for a segment of every step an
+  // output), while the host may still read the segment before's from the other.
+  const int half = team_sums_half_;
+  const auto half_rows = std::make_pair(half * team_segment_max_steps, (half + 1) * team_segment_max_steps);
+  if (num_outputs > 0) {
+    team_sums_half_ = 1 - team_sums_half_;
+    if (team_sums_.extent(1) != static_cast<std::size_t>(width + plan.watched.count)) {
+      // (A segment still waiting to be finished keeps its half of the old host copy: PendingSegment::sums.)
+      team_sums_ = Kokkos::View<double**, Kokkos::LayoutRight, MemSpace>(
+          Kokkos::view_alloc(space_, Kokkos::WithoutInitializing, "kushner::segment_sums"), 2 * team_segment_max_steps,
+          width + plan.watched.count);
+      team_sums_host_ = Kokkos::create_mirror_view(typename HostStaging<MemSpace>::space(), team_sums_);
+    }
+    plan.watched.values = Kokkos::subview(team_sums_, half_rows, Kokkos::ALL);
+    plan.watched.first_column = width;
   }
   std::vector<std::uintptr_t> addresses;
   for (const SegmentColumn& column : plan.columns) addresses.push_back(reinterpret_cast<std::uintptr_t>(column.column));
   Segment segment{step_kernel(k, dt, false),
                   k,
-                  0,
                   steps,
                   dt,
                   {},
-                  -1,
+                  plan.last_output,
                   {team_columns_.update(space_, addresses)},
                   plan.num_columns,
                   0,
@@ -799,8 +810,7 @@ void FilterBank<ExecSpace, Model, TruthModel>::step_team_segment(const long k, c
                   num_blocks,
                   width,
                   static_cast<int>(members_),
-                  team_blocks_,
-                  0};
+                  plan.watched};
   for (int s = 0; s < team_segment_max_steps; ++s) segment.output_of[s] = s < steps ? plan.output_of[s] : -1;
   if constexpr (!host_bank) {
     // The columns a GPU's team keeps in its block's sink: those the host's segments keep in theirs (SegmentColumn::
@@ -816,93 +826,64 @@ void FilterBank<ExecSpace, Model, TruthModel>::step_team_segment(const long k, c
         }
     });
   }
-  const auto launch = [&](const int first_block, const int blocks) {
-    if (blocks == 0) return;
-    segment.first_team = first_block;
-    const auto scratch = Kokkos::PerTeam(segment.scratch_bytes());
-    if constexpr (host_bank) {  // one thread per team (team_block_statistic's form)
-      Kokkos::parallel_for("kushner::filter_bank_team_segment",
-                           Kokkos::TeamPolicy<ExecSpace>(space_, blocks, 1).set_scratch_size(0, scratch), segment);
-    } else {  // a thread per member, as many as the step's registers let one CUDA block hold, in whole warps
-      // Bounds of 3 blocks of 256 per SM (80 registers on sm_90, some spilled, where the step took 120-128 and 2
-      // blocks fit) gave 1.14-1.27x the segments' rate on an H200 (perf/filter_bank.md); 4 blocks spilled more.
-      using Policy = Kokkos::TeamPolicy<ExecSpace, Kokkos::LaunchBounds<moment_block_size, 3>>;
-      auto probe = Policy(space_, blocks, Kokkos::AUTO);
-      probe.set_scratch_size(0, scratch);
-      const int most = probe.team_size_max(segment, Kokkos::ParallelForTag());
-      const int team_size = std::max(moment_lanes, std::min(moment_block_size, most) / moment_lanes * moment_lanes);
-      auto policy = Policy(space_, blocks, team_size);
-      policy.set_scratch_size(0, scratch);
-      Kokkos::parallel_for("kushner::filter_bank_team_segment", policy, segment);
+  const auto scratch = Kokkos::PerTeam(segment.scratch_bytes());
+  if constexpr (host_bank) {  // one thread per team (team_block_statistic's form)
+    Kokkos::parallel_for("kushner::filter_bank_team_segment",
+                         Kokkos::TeamPolicy<ExecSpace>(space_, num_blocks, 1).set_scratch_size(0, scratch), segment);
+  } else {  // a thread per member, as many as the step's registers let one CUDA block hold, in whole warps
+    // Bounds of 3 blocks of 256 per SM (80 registers on sm_90, some spilled, where the step took 120-128 and 2
+    // blocks fit) gave 1.14-1.27x the segments' rate on an H200 (perf/filter_bank.md); 4 blocks spilled more.
+    using Policy = Kokkos::TeamPolicy<ExecSpace, Kokkos::LaunchBounds<moment_block_size, 3>>;
+    auto probe = Policy(space_, num_blocks, Kokkos::AUTO);
+    probe.set_scratch_size(0, scratch);
+    const int most = probe.team_size_max(segment, Kokkos::ParallelForTag());
+    const int team_size = std::max(moment_lanes, std::min(moment_block_size, most) / moment_lanes * moment_lanes);
+    auto policy = Policy(space_, num_blocks, team_size);
+    policy.set_scratch_size(0, scratch);
+    Kokkos::parallel_for("kushner::filter_bank_team_segment", policy, segment);
 #if defined(KOKKOS_ENABLE_CUDA) && KOKKOS_VERSION < 40000
-      // Kokkos 3 launches a TeamPolicy kernel with cudaFuncCachePreferShared at its first launch (kokkos#2066, and
-      // only then: configure_shmem_preference): the shared memory for the block sinks of 3 blocks, and the rest L1,
-      // from the next launch on. On an H200 (1e6 members, four filters) the sink with Kokkos' carveout made steps
-      // without outputs x0.89; with this x1.02-1.03, and output steps x1.15-1.18 (perf/filter_bank.md). Set when
-      // it changes (a watched bank launches at every step): the device's shared memory per SM asked once.
-      if constexpr (std::is_same<ExecSpace, Kokkos::Cuda>::value) {
-        using Driver = Kokkos::Impl::ParallelFor<Segment, Policy, Kokkos::Cuda>;
-        static int per_sm = -1, carveout = -1;  // per kernel (this function's instance); one device per process
-        if (per_sm < 0) {
-          int device = 0;
-          per_sm = 0;
-          cudaGetDevice(&device);
-          cudaDeviceGetAttribute(&per_sm, cudaDevAttrMaxSharedMemoryPerMultiprocessor, device);
-        }
-        const double block_bytes = segment.scratch_bytes() + sizeof(double) * (team_size + 2) + 1024;  // + reserved
-        const int percent = per_sm > 0 ? std::min(100, static_cast<int>(std::ceil(300.0 * block_bytes / per_sm))) : 100;
-        if (percent != carveout) {
-          const auto kernel =
-              Kokkos::Impl::CudaParallelLaunch<Driver, typename Policy::launch_bounds>::get_kernel_func();
-          KUSHNER_REQUIRE(
-              cudaFuncSetAttribute(kernel, cudaFuncAttributePreferredSharedMemoryCarveout, percent) == cudaSuccess,
-              "start_segment: cudaFuncSetAttribute (shared memory carveout) failed");
-          carveout = percent;
-        }
+    // Kokkos 3 launches a TeamPolicy kernel with cudaFuncCachePreferShared at its first launch (kokkos#2066, and
+    // only then: configure_shmem_preference): the shared memory for the block sinks of 3 blocks, and the rest L1,
+    // from the next launch on. On an H200 (1e6 members, four filters) the sink with Kokkos' carveout made steps
+    // without outputs x0.89; with this x1.02-1.03, and output steps x1.15-1.18 (perf/filter_bank.md). Set when
+    // it changes; the device's shared memory per SM asked once.
+    if constexpr (std::is_same<ExecSpace, Kokkos::Cuda>::value) {
+      using Driver = Kokkos::Impl::ParallelFor<Segment, Policy, Kokkos::Cuda>;
+      static int per_sm = -1, carveout = -1;  // per kernel (this function's instance); one device per process
+      if (per_sm < 0) {
+        int device = 0;
+        per_sm = 0;
+        cudaGetDevice(&device);
+        cudaDeviceGetAttribute(&per_sm, cudaDevAttrMaxSharedMemoryPerMultiprocessor, device);
       }
-#endif
+      const double block_bytes = segment.scratch_bytes() + sizeof(double) * (team_size + 2) + 1024;  // + reserved
+      const int percent = per_sm > 0 ? std::min(100, static_cast<int>(std::ceil(300.0 * block_bytes / per_sm))) : 100;
+      if (percent != carveout) {
+        const auto kernel = Kokkos::Impl::CudaParallelLaunch<Driver, typename Policy::launch_bounds>::get_kernel_func();
+        KUSHNER_REQUIRE(
+            cudaFuncSetAttribute(kernel, cudaFuncAttributePreferredSharedMemoryCarveout, percent) == cudaSuccess,
+            "start_segment: cudaFuncSetAttribute (shared memory carveout) failed");
+        carveout = percent;
+      }
     }
-  };
-  const int watched = static_cast<int>(plan.watched_blocks.size());
-  for (int s = 0; s < steps && watched > 0; ++s) {
-    segment.s0 = s;
-    segment.s1 = s + 1;
-    segment.last_output = plan.output_of[s] >= 0 ? s : -1;
-    launch(0, watched);
-    if (plan.output_of[s] < 0 || !at_output) continue;
-    space_.fence();
-    at_output(s);
+#endif
   }
-  segment.s0 = 0;
-  segment.s1 = steps;
-  segment.last_output = plan.last_output;
-  launch(watched, num_blocks - watched);
-
   if (num_outputs == 0) return;
+  const auto sums = Kokkos::subview(team_sums_, half_rows, Kokkos::ALL);
   if (collective::ranks() > 1) {  // every rank's rows, gathered in rank order (the same branch on every rank)
     const auto rows = Kokkos::create_mirror_view_and_copy(
         Kokkos::HostSpace(), Kokkos::subview(team_rows_, std::make_pair(std::size_t(0), output_size * num_outputs)));
     pending.merged = merge_segment_rows(rows.data(), plan);
-    return;
+  } else {
+    merge_block_rows(space_,
+                     MergeBlockRows<MemSpace>{team_rows_, num_blocks, plan.num_columns, plan.counted.columns(), sums},
+                     num_outputs);
   }
-  if (team_sums_.extent(1) != static_cast<std::size_t>(width)) {  // room for two segments' every step an output
-    // (A segment still waiting to be finished keeps its half of the old host copy: PendingSegment::sums.)
-    team_sums_ = Kokkos::View<double**, Kokkos::LayoutRight, MemSpace>(
-        Kokkos::view_alloc(space_, Kokkos::WithoutInitializing, "kushner::segment_sums"), 2 * team_segment_max_steps,
-        width);
-    team_sums_host_ = Kokkos::create_mirror_view(typename HostStaging<MemSpace>::space(), team_sums_);
-  }
-  const auto half =
-      std::make_pair(team_sums_half_ * team_segment_max_steps, (team_sums_half_ + 1) * team_segment_max_steps);
-  team_sums_half_ = 1 - team_sums_half_;
-  const auto sums = Kokkos::subview(team_sums_, half, Kokkos::ALL);
-  merge_block_rows(space_,
-                   MergeBlockRows<MemSpace>{team_rows_, num_blocks, plan.num_columns, plan.counted.columns(), sums},
-                   num_outputs);
-  const auto host_sums = Kokkos::subview(team_sums_host_, half, Kokkos::ALL);
+  const auto host_sums = Kokkos::subview(team_sums_host_, half_rows, Kokkos::ALL);
   if (team_sums_host_.data() != team_sums_.data()) Kokkos::deep_copy(space_, host_sums, sums);
   pending.sums = host_sums;
-  pending.copied.record(space_);
+  team_sums_copied_[half].record(space_);
+  pending.copied = team_sums_copied_[half];  // a copy of the mark: the same event
 }
 
 template <class ExecSpace, class Model, class TruthModel>

@@ -46,15 +46,20 @@ struct FilterReport {
   long steps_run = 0;                           // steps of the main pass this process ran (fewer when resumed)
 };
 
-/// `observe` is called at t = 0 and at every output time with the bank and the outside estimators (PF, EXACT), e.g.
-/// to record chosen members' trajectories. It may read the global members `members` only: a run without outside
-/// estimators takes several steps at a time (FilterBank::start_segment), and at an output time only those are there.
+/// `observe` is called at t = 0 and at every output time, in order, with the bank and the outside estimators (PF,
+/// EXACT), e.g. to record chosen members' trajectories. `values` null: the bank is at t. Otherwise the bank may be
+/// further on, and `values` are the values at t of the elements `elements` named (in their order): a run without
+/// outside estimators takes several steps at a time (FilterBank::start_segment), which copy those elements at each
+/// output step. Without `elements`, such a run takes its steps one at a time.
 template <class ExecSpace, class Model, class TruthModel = Model>
 struct OutputObserver {
-  std::function<void(double t, const FilterBank<ExecSpace, Model, TruthModel>&,
-                     const std::vector<const ReferenceEstimator<typename ExecSpace::memory_space>*>&)>
+  using Bank = FilterBank<ExecSpace, Model, TruthModel>;
+  std::function<void(double t, const Bank&,
+                     const std::vector<const ReferenceEstimator<typename ExecSpace::memory_space>*>&,
+                     const std::vector<double>* values)>
       observe;
-  std::vector<long> members;
+  /// The elements of this rank's bank observe reads (the same at every output time, with no outside estimators).
+  std::function<std::vector<WatchedElement>(const Bank&)> elements;
 };
 
 /// Fewest members (of all ranks) for which a run takes its steps in segments: below it the blocks of
@@ -186,7 +191,7 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
     report.times.push_back(t);
     bank.start_snapshots(report.filters);
     collecting = true;
-    if (observer.observe) observer.observe(t, bank, outside_view);
+    if (observer.observe) observer.observe(t, bank, outside_view, nullptr);
   };
   struct StartedSegment {
     long k;
@@ -199,8 +204,11 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
     const auto series = bank.finish_segment();
     for (long s = 0, o = 0; s < static_cast<long>(segment.outputs.size()); ++s)
       if (segment.outputs[s]) {
-        report.times.push_back((segment.k + s + 1) * grid.dt);
-        report.series.push_back(series[o++]);
+        const double t = (segment.k + s + 1) * grid.dt;
+        report.times.push_back(t);
+        report.series.push_back(series[o].snapshots);
+        if (observer.observe) observer.observe(t, bank, outside_view, &series[o].watched);
+        ++o;
       }
   };
   const auto collect_step = [&] {
@@ -261,21 +269,19 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
   // Several steps at a time where nothing steps beside the bank (FilterBank::start_segment): on the host they doubled
   // the bank's rate, on a GPU 1.7-1.8x (perf/filter_bank.md). The same on every rank (the total member count), as
   // every rank must make the same collective calls.
-  const bool segments = bank.steps_in_segments() && share.total >= segment_min_members;
-  std::vector<long> watched;  // the observer's members in this rank's bank
-  for (const long member : observer.members)
-    if (share.holds(member)) watched.push_back(member - share.first);
+  const bool segments =
+      bank.steps_in_segments() && share.total >= segment_min_members && (!observer.observe || observer.elements);
+  const std::vector<WatchedElement> watched =
+      segments && observer.observe ? observer.elements(bank) : std::vector<WatchedElement>{};
   const auto take_segment = [&](const long k) {
     collect_step();  // the output at t = 0
     const long steps = std::min<long>(FilterBank<ExecSpace, Model, TruthModel>::segment_steps, grid.steps - k);
-    std::vector<char> outputs(steps, 0);
-    for (std::size_t s = 0; s < outputs.size(); ++s) {
-      outputs[s] = ends_at_output(k + static_cast<long>(s) + 1);
-      if (outputs[s]) ++next_output;
+    std::vector<char> outputs;
+    for (long s = 0; s < steps; ++s) {
+      outputs.push_back(ends_at_output(k + s + 1));
+      if (outputs.back()) ++next_output;
     }
-    bank.start_segment(k, grid.dt, outputs, report.filters, watched, [&](int s) {
-      if (observer.observe) observer.observe((k + s + 1) * grid.dt, bank, outside_view);
-    });
+    bank.start_segment(k, grid.dt, outputs, report.filters, watched);
     started_segments.push_back({k, std::move(outputs)});
     if (started_segments.size() > 1) collect_segment();  // the one before: merged while this one runs
     return k + steps;

@@ -2,6 +2,7 @@
 // second, next to the truth step alone in the same binary. ASRE runs a fixed 8 iterates per member (its
 // convergence passes are not part of a step; the seed models need 5-8 on average at tolerance 1e-6).
 #include "engine/filter_bank.hpp"
+#include "kernels/element_gather.hpp"
 #include "kernels/filters/filter_list.hpp"
 #include "models/cubic_oscillator_model.hpp"
 #include "models/sine_model.hpp"
@@ -10,6 +11,7 @@
 #include <benchmark/benchmark.h>
 
 #include <string>
+#include <vector>
 
 namespace kushner {
 namespace {
@@ -76,16 +78,28 @@ void BM_FilterBankOutputSteps(benchmark::State& state) {
 
 /// BM_FilterBankOutputSteps' steps taken FilterBank::segment_steps at a time (FilterBank::start_segment: on the host in
 /// chunks, as engine/filter_run.hpp takes them; on a GPU in teams). Arg 2 = 1: members 0 .. 2 watched (`compare`'s
-/// traced members: their block takes the steps one at a time first); 0: none (`kushner filter`).
+/// traced members: their truths and each filter's m and P copied at every output step); 0: none (`kushner filter`).
 template <class Model>
 void BM_FilterBankSegments(benchmark::State& state) {
   const long members = state.range(0);
   const bool output = state.range(1) != 0;
-  const std::vector<long> watched = state.range(2) != 0 ? std::vector<long>{0, 1, 2} : std::vector<long>{};
   const Space space;
   const std::vector<std::string> filters{"EKF", "SOF", "QLF", "KBL"};
   using Bank = FilterBank<Space, Model>;
   Bank bank(space, Model{}, Model{}, members, 42, filters);
+  std::vector<WatchedElement> watched;
+  const auto watch = [&](const auto& view, long member) {
+    for (int i = 0; i < static_cast<int>(view.extent(1)); ++i)
+      watched.push_back({element_address(view, member, i), member});
+  };
+  for (long member = 0; member < (state.range(2) != 0 ? 3 : 0); ++member) {
+    watch(bank.truths().state(), member);
+    for (const auto& name : filters)
+      bank.with_slot(name, [&](const auto& slot) {
+        watch(slot.m, member);
+        watch(slot.P, member);
+      });
+  }
   const std::vector<char> outputs(Bank::segment_steps, output ? 1 : 0);
   long k = 0;
   for (auto _ : state) {

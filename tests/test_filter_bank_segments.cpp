@@ -9,6 +9,7 @@
 // form (a GPU's segments), on the host and, where the build has one, on the device. Then run_filters, which takes
 // segments from 4096 members, against a bank stepped by hand.
 #include "engine/filter_run.hpp"
+#include "kernels/element_gather.hpp"
 #include "kernels/filters/filter_list.hpp"
 #include "models/cubic_sensor_model.hpp"
 #include "models/linear_discrete_model.hpp"
@@ -72,21 +73,42 @@ void expect_same_view(const View& a, const View& b, const std::string& what, dou
   EXPECT_EQ(differ, 0) << what << ": entries that differ";
 }
 
-/// The truth and every filter's estimate of `member`, as an observer at an output time reads them.
+/// f(view) for each view an observer reads of a member, in order: the truths, then each filter's m and P.
+template <class Bank, class F>
+void for_each_observed_view(const Bank& bank, const std::vector<std::string>& filters, const F& f) {
+  f(bank.truths().state());
+  for (const auto& name : filters)
+    bank.with_slot(name, [&](const auto& slot) {
+      f(slot.m);
+      f(slot.P);
+    });
+}
+
+/// The values of `member` an observer at an output time reads.
 template <class Bank>
 std::vector<double> member_values(const Bank& bank, const std::vector<std::string>& filters, long member) {
   std::vector<double> values;
-  const auto take = [&](const auto& view) {
+  for_each_observed_view(bank, filters, [&](const auto& view) {
     const auto row = host_copy(Kokkos::subview(view, member, Kokkos::ALL));
     for (std::size_t i = 0; i < row.extent(0); ++i) values.push_back(row(i));
-  };
-  take(bank.truths().state());
-  for (const auto& name : filters) bank.with_slot(name, [&](const auto& slot) { take(slot.m); });
+  });
   return values;
 }
 
+/// member_values' elements (element_address), in its order: what a segment copies at each output step.
+template <class Bank>
+std::vector<WatchedElement> member_elements(const Bank& bank, const std::vector<std::string>& filters, long member) {
+  std::vector<WatchedElement> elements;
+  for_each_observed_view(bank, filters, [&](const auto& view) {
+    for (int i = 0; i < static_cast<int>(view.extent(1)); ++i)
+      elements.push_back({element_address(view, member, i), member});
+  });
+  return elements;
+}
+
 /// Steps [0, sum of `segments`) with output steps at the ends of steps `output_ends` (k + 1 for step k), one step at a
-/// time and in segments of the given sizes, members `watched` read at each output time; then everything compared:
+/// time and in segments of the given sizes, members `watched` read at each output time (a segment copies their
+/// elements as it takes an output step); then everything compared:
 /// the same bits on the host (`teams`: the team form of a GPU's segments), within `relative` on a device.
 template <class Model, class BankSpace = Space>
 void expect_segments_match_steps(const Model& model, const std::vector<std::string>& filters, double dt,
@@ -120,17 +142,26 @@ void expect_segments_match_steps(const Model& model, const std::vector<std::stri
   // half of the team form's buffers).
   std::vector<std::vector<FilterSnapshot>> segment_snapshots;
   std::vector<std::vector<double>> segment_watched;
+  std::vector<WatchedElement> elements;
+  for (const long member : watched) {
+    const std::vector<WatchedElement> e = member_elements(segmented, filters, member);
+    elements.insert(elements.end(), e.begin(), e.end());
+  }
   const auto finish_segment = [&] {
-    const auto snapshots = segmented.finish_segment();
-    segment_snapshots.insert(segment_snapshots.end(), snapshots.begin(), snapshots.end());
+    for (const auto& output : segmented.finish_segment()) {
+      segment_snapshots.push_back(output.snapshots);
+      ASSERT_EQ(output.watched.size(), elements.size());
+      const std::size_t per_member = elements.size() / watched.size();
+      for (std::size_t i = 0; i < watched.size(); ++i)
+        segment_watched.emplace_back(output.watched.begin() + i * per_member,
+                                     output.watched.begin() + (i + 1) * per_member);
+    }
   };
   long k = 0;
   for (const int size : segments) {
     std::vector<char> outputs(size);
     for (int s = 0; s < size; ++s) outputs[s] = is_output(k + s + 1) ? 1 : 0;
-    segmented.start_segment(k, dt, outputs, filters, watched, [&](int) {
-      for (const long member : watched) segment_watched.push_back(member_values(segmented, filters, member));
-    });
+    segmented.start_segment(k, dt, outputs, filters, elements);
     if (k > 0) finish_segment();
     k += size;
   }
@@ -216,29 +247,43 @@ TEST(FilterBankSegments, GpuSegmentsGiveTheNumbersOfStepsOneAtATime) {
   }
 }
 
-/// The observer's view of run_filters' watched members, and the report, against a bank stepped one step at a time.
+/// The observer's view of run_filters' watched members (copied by the segments at each output step), and the report,
+/// against a bank stepped one step at a time.
 TEST(FilterBankSegments, RunFiltersTakesSegmentsWithTheNumbersOfStepsOneAtATime) {
   constexpr long members = segment_min_members + 300;
   const std::vector<std::string> filters{"EKF", "SOF", "QLF", "KBL"};
   const TimeGrid grid = make_time_grid(0.05, 1e-3, 20);  // 50 steps, outputs every 2
   const std::uint32_t seed = 11;
   const std::vector<long> watched{2, members - 1};
-  constexpr long unwatched =
-      300;  // in a block of its own: where a segment leaves it at an output time says segments ran
   using Bank = FilterBank<Space, SineModel>;
-  std::vector<std::vector<double>> seen, seen_unwatched;
-  OutputObserver<Space, SineModel> observer{[&](double, const Bank& bank, const auto&) {
-                                              for (const long m : watched)
-                                                seen.push_back(member_values(bank, filters, m));
-                                              seen_unwatched.push_back(member_values(bank, filters, unwatched));
-                                            },
-                                            watched};
+  const auto watched_values = [&](const Bank& bank) {
+    std::vector<double> values;
+    for (const long m : watched) {
+      const std::vector<double> v = member_values(bank, filters, m);
+      values.insert(values.end(), v.begin(), v.end());
+    }
+    return values;
+  };
+  std::vector<std::vector<double>> seen;
+  long copied_by_segments = 0;
+  OutputObserver<Space, SineModel> observer{
+      [&](double, const Bank& bank, const auto&, const std::vector<double>* values) {
+        seen.push_back(values ? *values : watched_values(bank));
+        copied_by_segments += values ? 1 : 0;
+      },
+      [&](const Bank& bank) {
+        std::vector<WatchedElement> elements;
+        for (const long m : watched) {
+          const std::vector<WatchedElement> e = member_elements(bank, filters, m);
+          elements.insert(elements.end(), e.begin(), e.end());
+        }
+        return elements;
+      }};
   const FilterReport report =
       run_filters(Space(), SineModel{}, SineModel{}, members, seed, grid, filters, {}, {}, {}, observer);
 
   Bank bank(Space(), SineModel{}, SineModel{}, members, member_share(members).seed(seed), filters);
-  std::vector<std::vector<double>> expected, expected_unwatched{member_values(bank, filters, unwatched)};
-  for (const long m : watched) expected.push_back(member_values(bank, filters, m));
+  std::vector<std::vector<double>> expected{watched_values(bank)};
   std::vector<std::vector<FilterSnapshot>> series{bank.snapshots(filters)};
   std::vector<double> times{0.0};
   for (long k = 0, o = 1; k < grid.steps; ++k) {
@@ -248,8 +293,7 @@ TEST(FilterBankSegments, RunFiltersTakesSegmentsWithTheNumbersOfStepsOneAtATime)
     ++o;
     series.push_back(bank.snapshots(filters));
     times.push_back((k + 1) * grid.dt);
-    for (const long m : watched) expected.push_back(member_values(bank, filters, m));
-    expected_unwatched.push_back(member_values(bank, filters, unwatched));
+    expected.push_back(watched_values(bank));
   }
   ASSERT_EQ(report.times.size(), times.size());
   for (std::size_t o = 0; o < times.size(); ++o) {
@@ -257,13 +301,12 @@ TEST(FilterBankSegments, RunFiltersTakesSegmentsWithTheNumbersOfStepsOneAtATime)
     expect_same_snapshots(series[o], report.series[o], "output " + std::to_string(o));
   }
   ASSERT_EQ(seen.size(), expected.size());
-  for (std::size_t i = 0; i < seen.size(); ++i)
+  for (std::size_t i = 0; i < seen.size(); ++i) {
+    ASSERT_EQ(seen[i].size(), expected[i].size()) << "observer's read " << i;
     for (std::size_t j = 0; j < seen[i].size(); ++j)
       EXPECT_TRUE(same_bits(seen[i][j], expected[i][j])) << "observer's read " << i << ", value " << j;
-  long unwatched_elsewhere = 0;
-  for (std::size_t i = 0; i < expected_unwatched.size(); ++i)
-    unwatched_elsewhere += seen_unwatched.at(i) == expected_unwatched[i] ? 0 : 1;
-  EXPECT_GT(unwatched_elsewhere, 0) << "every member was at every output time: run_filters took no segments";
+  }
+  EXPECT_EQ(copied_by_segments, static_cast<long>(times.size()) - 1) << "run_filters took no segments";
   for (std::size_t f = 0; f < filters.size(); ++f) {
     const FilterScores s = bank.scores(filters[f], grid.steps + 1);
     EXPECT_TRUE(same_bits(report.scores[f].rmse_truth.value, s.rmse_truth.value)) << filters[f];

@@ -19,6 +19,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <new>
+#include <vector>
 
 namespace kushner {
 
@@ -29,6 +30,38 @@ struct SegmentColumn {
   int sink;
 };
 
+/// An element of a bank view (element_address of (member, column): a truth's, or a filter's m or P) that a segment
+/// copies at each of its output steps: what an observer reads of a few members (drivers/trajectory_recorder.hpp).
+struct WatchedElement {
+  std::uintptr_t address;
+  long member;
+};
+
+/// A segment's watched elements and where their values go: the block that holds element i's member copies it to
+/// values(output, first_column + i) once it took that output step, the other blocks being at other steps then.
+template <class MemSpace>
+struct WatchedElements {
+  Kokkos::View<const std::uintptr_t*, MemSpace> list;  // the count addresses, then their members' blocks
+  int count = 0;
+  Kokkos::View<double**, Kokkos::LayoutRight, MemSpace> values;
+  int first_column = 0;
+
+  /// The lists start_segment uploads: the addresses, then the blocks.
+  static std::vector<std::uintptr_t> list_of(const std::vector<WatchedElement>& elements) {
+    std::vector<std::uintptr_t> list;
+    for (const WatchedElement& e : elements) list.push_back(e.address);
+    for (const WatchedElement& e : elements) list.push_back(static_cast<std::uintptr_t>(e.member / moment_block_size));
+    return list;
+  }
+
+  /// Block b's elements at output `output`, element i by `thread` (of `threads`) where i % threads == thread.
+  KOKKOS_INLINE_FUNCTION void copy_block(const int b, const int output, const int thread, const int threads) const {
+    for (int i = thread; i < count; i += threads)
+      if (list(count + i) == static_cast<std::uintptr_t>(b))
+        values(output, first_column + i) = *reinterpret_cast<const double*>(list(i));
+  }
+};
+
 /// Members i of a block's contiguous values (block_statistic from 0: member begin + i is lane i % moment_lanes,
 /// as when it runs from begin).
 struct BlockValues {
@@ -37,10 +70,9 @@ struct BlockValues {
 };
 
 /// `Step`: a FilterBankStep; `Counted`: NotOkMembers (kernels/filters/filter_metrics.hpp), with count(s, begin, end).
-/// operator()(b): block b takes steps first_step .. first_step + steps - 1 (unless it is among `skipped`, which the
-/// caller steps itself with run_block). Output step s (output_of[s] >= 0) leaves block b's row of output output_of[s]
-/// at rows + (output_of[s] num_blocks + b) width: per column its BlockStatistic (BlockStatistics' layout), per counted
-/// column its count.
+/// operator()(b): block b takes steps first_step .. first_step + steps - 1. Output step s (output_of[s] >= 0) leaves
+/// block b's row of output output_of[s] at rows + (output_of[s] num_blocks + b) width: per column its BlockStatistic
+/// (BlockStatistics' layout), per counted column its count; and the values of the watched elements in block b.
 template <class Step, class Counted>
 struct FilterBankSegment {
   static constexpr int sink_doubles = 2 * Step::num_filters * moment_block_size;
@@ -56,24 +88,16 @@ struct FilterBankSegment {
   Counted counted;
   double* rows;
   int num_blocks, width, members;
-  const int* skipped;  // blocks operator() leaves alone, in increasing order
-  int num_skipped;
+  WatchedElements<Kokkos::HostSpace> watched;
 
   void operator()(const int b) const {
-    for (int i = 0; i < num_skipped; ++i)
-      if (skipped[i] == b) return;
-    run_block(b, 0, steps);
-  }
-
-  /// Block b's steps [first_step + s0, first_step + s1).
-  KUSHNER_SAME_CODE_FOR_ALL_CALLERS void run_block(const int b, const int s0, const int s1) const {
     double sink[sink_doubles];
     const int begin = b * moment_block_size, end = block_end(b, members);
     Step step = first;
     step.snapshot_sink = sink;
     step.sink_first = begin;
     step.sink_stride = moment_block_size;
-    for (int s = s0; s < s1; ++s) {
+    for (int s = 0; s < steps; ++s) {
       const long k = first_step + s;
       step.truth.t = k * dt;  // run_step_kernel's time, bit for bit
       step.truth.step = static_cast<std::uint32_t>(k);
@@ -87,6 +111,7 @@ struct FilterBankSegment {
         store_block_row(row, num_columns, c, block_statistic(BlockValues{x}, 0, end - begin));
       }
       for (int c = 0; c < counted.columns(); ++c) row[3 * num_columns + c] = counted.count(c, begin, end);
+      watched.copy_block(b, output_of[s], 0, 1);
       if (s != last_output) continue;
       // What a step at a time leaves in the snapshot columns (a checkpoint saves them); only then read again.
       for (int c = 0; c < num_columns; ++c)
@@ -104,8 +129,9 @@ constexpr int team_segment_max_steps = 32;
 /// per thread), each block through every step, its columns in the SM's caches from step to step (a step at a time
 /// streamed each member's ~420 bytes from device memory and back at every step). After an output step the team's
 /// warps reduce the block's snapshot values (written by its own threads, read after a barrier) to its BlockStatistic
-/// rows and divergence counts, as BlockColumnStatistics' warps do after a step at a time; the rows of every output
-/// go to `rows` (output, block, width), merged where they are (MergeBlockRows). On a GPU the columns in `sink_mask`
+/// rows and divergence counts, as BlockColumnStatistics' warps do after a step at a time, and its threads copy the
+/// block's watched elements; the rows of every output go to `rows` (output, block, width), merged where they are
+/// (MergeBlockRows). On a GPU the columns in `sink_mask`
 /// (those of the filters whose slot has a team_sink: column c at c moment_block_size in the block's sink) are
 /// written to and reduced from shared memory, and the launch's last output step copies them to the snapshot
 /// columns, what a step at a time leaves there; 16 bytes per filter and member written to device memory and read
@@ -116,22 +142,21 @@ template <class Step, class Counted, class MemSpace>
 struct FilterBankTeamSegment {
   Step first;  // step first_step's kernel; each step's time, index and output flag are set from it
   long first_step;
-  int s0, s1;  // the steps this launch takes: first_step + s0 .. first_step + s1 - 1
+  int steps;  // it takes steps first_step .. first_step + steps - 1
   double dt;
   int output_of[team_segment_max_steps];  // per step of the segment: its output's index, or -1
-  int last_output;                        // the launch's last output step (in [s0, s1)), or -1
+  int last_output;                        // the last output step, or -1
   ColumnAddresses<MemSpace> columns;
   int num_columns;
   std::uint64_t sink_mask;  // GPU: bit c, column c is in the block's sink (team_sink_values)
   Counted counted;
   Kokkos::View<double*, MemSpace> rows;
   int num_blocks, width, members;
-  Kokkos::View<const int*, MemSpace> blocks;  // team i's block: blocks(first_team + i)
-  int first_team;
+  WatchedElements<MemSpace> watched;
 
   template <class Team>
   KOKKOS_INLINE_FUNCTION void operator()(const Team& team) const {
-    const int b = blocks(first_team + team.league_rank());
+    const int b = team.league_rank();
     const int begin = b * moment_block_size, end = block_end(b, members);
 #if KUSHNER_CUDA_DEVICE_PASS
     // Each thread passes a step's time, index and output flag to the step kernel, read where the launch put it
@@ -141,7 +166,7 @@ struct FilterBankTeamSegment {
     // meets only at output steps, where its warps reduce what its threads wrote.
     if (sink_mask != 0 && team.team_shmem().get_shmem(sink_bytes()) != team_sink_values())
       Kokkos::abort("FilterBankTeamSegment: the team's scratch is not where team_sink_values looks for it");
-    for (int s = s0; s < s1; ++s) {
+    for (int s = 0; s < steps; ++s) {
       const long k = first_step + s;
       const bool output = output_of[s] >= 0;
       for (int m = begin + team.team_rank(); m < end; m += team.team_size())
@@ -149,6 +174,7 @@ struct FilterBankTeamSegment {
       if (!output) continue;
       team.team_barrier();  // every member's snapshot values are written
       reduce_block(team, output_row(s, b), begin, end, nullptr);
+      watched.copy_block(b, output_of[s], team.team_rank(), team.team_size());
       if (s == last_output) sink_to_columns(team, begin, end);  // each thread its own members' values: no barrier
       team.team_barrier();  // and read, before a later output step writes them again
     }
@@ -160,7 +186,7 @@ struct FilterBankTeamSegment {
     const std::ptrdiff_t bytes = block_team_scratch_bytes;
     double* const scratch = static_cast<double*>(team.team_shmem().get_shmem(bytes));
     Kokkos::single(Kokkos::PerTeam(team), [&]() { new (step) Step(first); });
-    for (int s = s0; s < s1; ++s) {
+    for (int s = 0; s < steps; ++s) {
       Kokkos::single(Kokkos::PerTeam(team), [&]() {
         const long k = first_step + s;
         step->truth.t = k * dt;  // run_step_kernel's time, bit for bit
@@ -170,7 +196,9 @@ struct FilterBankTeamSegment {
       team.team_barrier();  // the step's fields are set
       step_block(*step, begin, end);
       team.team_barrier();  // every member took the step (its snapshot values are written) before the fields change
-      if (output_of[s] >= 0) reduce_block(team, output_row(s, b), begin, end, scratch);
+      if (output_of[s] < 0) continue;
+      reduce_block(team, output_row(s, b), begin, end, scratch);
+      Kokkos::single(Kokkos::PerTeam(team), [&]() { watched.copy_block(b, output_of[s], 0, 1); });
     }
     team.team_barrier();
     Kokkos::single(Kokkos::PerTeam(team), [&]() { step->~Step(); });
