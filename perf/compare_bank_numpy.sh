@@ -101,5 +101,5 @@ per_filter = 8 * 2 + 8 * 2 + 1 + 3 * 16 + 2 * 8
 bytes_per = 8 * 2 + 8 * 2 + 1 + 4 * per_filter
 print(f"copy bandwidth {copy['GB_per_s']:.3g} GB/s ({copy['note']}); bank traffic ~{bytes_per} B per member-step "
       f"-> floor ~{copy['GB_per_s'] * 1e9 / bytes_per:.3g} member-steps/s for a step at a time (from 4096 members "
-      f"the host takes steps 16 at a time, FilterBank::step_segment, moving these bytes once per segment)")
+      f"the host takes steps 16 at a time, FilterBank::start_segment, moving these bytes once per segment)")
 PY

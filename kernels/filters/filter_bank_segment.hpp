@@ -173,8 +173,11 @@ struct FilterBankTeamSegment {
         first.step_at(m, k * dt, static_cast<std::uint32_t>(k), output);  // k * dt: run_step_kernel's time
       if (!output) continue;
       team.team_barrier();  // every member's snapshot values are written
-      reduce_block(team, output_row(s, b), begin, end, nullptr);
+      // The watched elements before the reduction: after it, the copy made the whole kernel spill more (ptxas: 96 ->
+      // 128 bytes of spill stores), and a bank watching none ran at x0.96-0.97 of the bank before the copy instead of
+      // x0.98-0.99 (an H200, 1e6 members; perf/filter_bank.md).
       watched.copy_block(b, output_of[s], team.team_rank(), team.team_size());
+      reduce_block(team, output_row(s, b), begin, end, nullptr);
       if (s == last_output) sink_to_columns(team, begin, end);  // each thread its own members' values: no barrier
       team.team_barrier();  // and read, before a later output step writes them again
     }
@@ -197,8 +200,8 @@ struct FilterBankTeamSegment {
       step_block(*step, begin, end);
       team.team_barrier();  // every member took the step (its snapshot values are written) before the fields change
       if (output_of[s] < 0) continue;
-      reduce_block(team, output_row(s, b), begin, end, scratch);
       Kokkos::single(Kokkos::PerTeam(team), [&]() { watched.copy_block(b, output_of[s], 0, 1); });
+      reduce_block(team, output_row(s, b), begin, end, scratch);
     }
     team.team_barrier();
     Kokkos::single(Kokkos::PerTeam(team), [&]() { step->~Step(); });

@@ -169,7 +169,7 @@ for f in summary.json timeseries.csv trajectories.csv density.csv; do
 done
 rm -rf "$work/run"
 
-# The bank alone on the host from 4096 members takes its steps in segments (FilterBank::step_segment), so its
+# The bank alone on the host from 4096 members takes its steps in segments (FilterBank::start_segment), so its
 # checkpoints fall between segments: killed at one, stopped by SIGINT at another, resumed, the same files.
 segments=(compare --model sine --filters EKF,QLF,UKF,EnKBF --enkbf-particles 20 --members 5000 --T 2 --dt 1e-3
           --output-points 300 --trajectory-members 0,4500 --no-plots --quiet --seed 8 --checkpoint-every 0.05)

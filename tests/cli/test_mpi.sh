@@ -56,7 +56,7 @@ check compare compare --model cubic-oscillator --filters EKF,QLF,UKF,PF --member
   --particles 64 --trajectory-members 650,0,300 --density-times 0.1,0.3 --output-points 6 --no-plots --seed 6
 check control control --model sine --members 600 --T 0.3 --dt 1e-2 --particles 64 --trace-member 550 --seed 4 \
   --controllers NONE@state,LQR@EKF,LQR@PF,ASRE@ASRE --cost Q=1 --no-plots
-# The bank alone on the host from 4096 members takes its steps in segments (FilterBank::step_segment): 5000 members
+# The bank alone on the host from 4096 members takes its steps in segments (FilterBank::start_segment): 5000 members
 # are 20 blocks (shares of 6, 7, 7 over 3 ranks), the traced members on the first, middle and last rank.
 check segments compare --model sine --filters EKF,SOF,QLF,KBL --members 5000 --T 0.3 --dt 1e-2 --output-points 7 \
   --trajectory-members 4999,0,2600 --no-plots --seed 12
