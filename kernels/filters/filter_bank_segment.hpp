@@ -131,9 +131,9 @@ constexpr int team_segment_max_steps = 32;
 /// warps reduce the block's snapshot values (written by its own threads, read after a barrier) to its BlockStatistic
 /// rows and divergence counts, as BlockColumnStatistics' warps do after a step at a time, and its threads copy the
 /// block's watched elements; the rows of every output go to `rows` (output, block, width), merged where they are
-/// (MergeBlockRows). On a GPU the columns in `sink_mask`
-/// (those of the filters whose slot has a team_sink: column c at c moment_block_size in the block's sink) are
-/// written to and reduced from shared memory, and the launch's last output step copies them to the snapshot
+/// (MergeBlockRows). On a GPU the columns in `sink_mask` (those of the filters whose slot has a team_sink: column c
+/// at c moment_block_size in the block's sink) are written to and reduced from shared memory, and the launch's last
+/// output step copies them to the snapshot
 /// columns, what a step at a time leaves there; 16 bytes per filter and member written to device memory and read
 /// back at every output step made such a step 1.5x a step without outputs (1e6 members, four filters, an H200). On
 /// the host (the tests' check of this form) a team is one thread, which steps its block chunk by chunk
