@@ -125,19 +125,18 @@ struct FilterBankSegment {
 /// Most steps of a FilterBankTeamSegment launch (its output indices travel in the kernel's arguments).
 constexpr int team_segment_max_steps = 32;
 
-/// A segment on a GPU: one team per block of moment_block_size members (a CUDA block of up to 256 threads, a member
-/// per thread), each block through every step, its columns in the SM's caches from step to step (a step at a time
-/// streamed each member's ~420 bytes from device memory and back at every step). After an output step the team's
-/// warps reduce the block's snapshot values (written by its own threads, read after a barrier) to its BlockStatistic
-/// rows and divergence counts, as BlockColumnStatistics' warps do after a step at a time, and its threads copy the
-/// block's watched elements; the rows of every output go to `rows` (output, block, width), merged where they are
-/// (MergeBlockRows). On a GPU the columns in `sink_mask` (those of the filters whose slot has a team_sink: column c
-/// at c moment_block_size in the block's sink) are written to and reduced from shared memory, and the launch's last
-/// output step copies them to the snapshot
-/// columns, what a step at a time leaves there; 16 bytes per filter and member written to device memory and read
-/// back at every output step made such a step 1.5x a step without outputs (1e6 members, four filters, an H200). On
-/// the host (the tests' check of this form) a team is one thread, which steps its block chunk by chunk
-/// (run_member_chunk) and reduces it with team_block_statistic: the numbers of FilterBankSegment.
+/// A segment on a GPU: one team per block of moment_block_size members (a CUDA block of up to 256 threads, a member per
+/// thread), each block through every step, its columns in the SM's caches from step to step (a step at a time streamed
+/// each member's ~420 bytes from device memory and back at every step). After an output step the team's warps reduce
+/// the block's snapshot values (written by its own threads, read after a barrier) to its BlockStatistic rows and
+/// divergence counts, as BlockColumnStatistics' warps do after a step at a time, and its threads copy the block's
+/// watched elements; the rows of every output go to `rows` (output, block, width), merged where they are
+/// (MergeBlockRows). On a GPU the columns in `sink_mask` (those of the filters whose slot has a team_sink: column c at
+/// c moment_block_size in the block's sink) are written to and reduced from shared memory, and the launch's last output
+/// step copies them to the snapshot columns, what a step at a time leaves there; 16 bytes per filter and member written
+/// to device memory and read back at every output step made such a step 1.5x a step without outputs (1e6 members, four
+/// filters, an H200). On the host (the tests' check of this form) a team is one thread, which steps its block chunk by
+/// chunk (run_member_chunk) and reduces it with team_block_statistic: the numbers of FilterBankSegment.
 template <class Step, class Counted, class MemSpace>
 struct FilterBankTeamSegment {
   Step first;  // step first_step's kernel; each step's time, index and output flag are set from it
