@@ -16,10 +16,10 @@
 // side by side with and without Kokkos::Serial's copy: 155 -> 127 s, its object 7.4 -> 5.4 MB). The price is OpenMP's
 // parallel region around each kernel on one thread: a one-member run of 80000 steps, 16.0 -> 18.0 s (medians of 5)
 // (`reproduce basin-car-filter`). Kokkos::Serial runs it only in a build without OpenMP (KUSHNER_RUNS_SERIAL), and not
-// in CI's CUDA compile check (KUSHNER_CUDA_COMPILE_CHECK), which compiles the commands for the GPU alone.
+// in a CUDA build for the GPU alone (KUSHNER_GPU_BACKEND_ONLY: CI's CUDA compile check, and the CMake option).
 #if defined(KOKKOS_ENABLE_OPENMP)
 #define KUSHNER_SERIAL_ON_OPENMP
-#elif defined(KOKKOS_ENABLE_SERIAL) && !defined(KUSHNER_CUDA_COMPILE_CHECK)
+#elif defined(KOKKOS_ENABLE_SERIAL) && !defined(KUSHNER_GPU_BACKEND_ONLY)
 #define KUSHNER_RUNS_SERIAL
 #endif
 

@@ -5,6 +5,9 @@
 #          not finish it; the build resumes where the last call stopped)
 #          The run phase after it takes more than the rest of a 10-minute call (test_filter_determinism.sh alone
 #          190 s): give each phase a call of its own, back to back while the machine stays warm.
+#          KUSHNER_BANK_GPU_ONLY=1: the commands for the GPU alone (-DKUSHNER_GPU_BACKEND_ONLY=ON, Ninja, tests and
+#          benchmarks off): kushner from nothing in 369 s of 16 cores, one call; the run phase's two checks then
+#          cannot run (test_ensemble_moments not built, no serial backend to hold CUDA against), its figures can.
 #   segments  a light build of its own (build-cuda-segments/: test_filter_bank_segments, test_ensemble_moments and
 #          bench_filter_bank, the models' shared instances off: only what they use is compiled; on 16 cores 4.3 minutes
 #          for the first two built one after another), test_filter_bank_segments on the GPU (segments in teams against a step at a time) and
@@ -43,11 +46,19 @@ nvidia-smi --query-gpu=name,memory.total,power.limit,clocks.max.sm,driver_versio
 
 if want build; then
   log "configure"
-  cmake -C "$here/perf/gpu_machine.cmake" -S "$source_tree" -B "$build" \
+  targets=(kushner test_ensemble_moments)
+  gpu_only=()
+  if [ -n "${KUSHNER_BANK_GPU_ONLY:-}" ]; then
+    ninja=$(command -v ninja || ls /opt/torch/.venv/bin/ninja 2> /dev/null | head -1)
+    gpu_only=(-DKUSHNER_GPU_BACKEND_ONLY=ON -DKUSHNER_ENABLE_TESTS=OFF -DKUSHNER_ENABLE_BENCHMARKS=OFF)
+    [ -n "$ninja" ] && gpu_only+=(-G Ninja -DCMAKE_MAKE_PROGRAM="$ninja")
+    targets=(kushner)
+  fi
+  cmake "${gpu_only[@]}" -C "$here/perf/gpu_machine.cmake" -S "$source_tree" -B "$build" \
     -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON -DKUSHNER_ENABLE_OPENMP=OFF \
     -DKUSHNER_ENABLE_SERIAL=ON -DKUSHNER_ENABLE_MPI=OFF > "$out/configure.log" 2>&1 ||
     { tail -20 "$out/configure.log"; exit 1; }
-  cmake --build "$build" -j"$(nproc)" --target kushner test_ensemble_moments > "$out/build.log" 2>&1 || status=1
+  cmake --build "$build" -j"$(nproc)" --target "${targets[@]}" > "$out/build.log" 2>&1 || status=1
   grep -h -B2 -A10 -m3 " error" "$out/build.log" | head -40
   log "built (status $status)"
 fi
