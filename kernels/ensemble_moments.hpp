@@ -163,7 +163,11 @@ __device__ BlockStatistic warp_block_statistic(const int j, const Value& value, 
   if (n > 0 && math::is_finite(total)) {
     BlockStatistic s;
     s.count = static_cast<double>(n);
-    s.mean = total / s.count;
+    // A whole block's mean by a multiply: total / 2^8 and total 2^-8 round the same number, so the same bits, without
+    // a double division's ~40 instructions and their latency between the two passes of every column (output steps of
+    // a GPU segment x1.012: perf/filter_bank.md).
+    static_assert((moment_block_size & (moment_block_size - 1)) == 0, "a power of two");
+    s.mean = n == moment_block_size ? total * (1.0 / moment_block_size) : total / s.count;
     double ss = 0.0;
     KUSHNER_DEVICE_UNROLL
     for (int k = 0; k < K; ++k) {

@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # The filter bank on the GPU through the command line against the same bank in JAX (issue 16 part 4):
 #   kushner filter --model sine --filters EKF,SOF,QLF,KBL --members M --quiet (CUDA backend) at T = 0.25 and 0.05
-# (dt = 1e-3): member-steps/s from the difference of summary.json's step_loop_s (and of the whole commands' wall
-# times), perf/bank_jax.py the same way (fp64, lax.scan), and the device's copy bandwidth (JAX, x + 0 over 2 GiB:
-# read + write) for the floor: ~421 B per member-step (truth x, dy; per filter m, P, status, scores, snapshots).
+# (dt = 1e-3; with the default 200 output points every step of both is an output step): member-steps/s from the
+# difference of summary.json's step_loop_s (and of the whole commands' wall times), perf/bank_jax.py the same way
+# (fp64, lax.scan; without and with --metrics, the command line's work), and the device's copy bandwidth (JAX, x + 0
+# over 2 GiB: read + write) for the floor: ~421 B per member-step (truth x, dy; per filter m, P, status, scores,
+# snapshots).
 #   perf/compare_bank_gpu.sh BUILD_DIR    (a CUDA build's kushner; prints one line per figure)
 set -euo pipefail
 build=${1:?usage: compare_bank_gpu.sh BUILD_DIR}
@@ -39,6 +41,8 @@ print("kushner CLI (CUDA): step loop %.3g member-steps/s (median of %s), whole c
       (statistics.median(loop), ["%.3g" % r for r in loop], statistics.median(wall)))
 PY
 python3 "$(dirname "$0")/bank_jax.py" --members "$members" --T 0.25 --rate 0.05 --repetitions "$reps"
+# The same bank with the command line's statuses, score sums and moments at every step (its output steps here).
+python3 "$(dirname "$0")/bank_jax.py" --members "$members" --T 0.25 --rate 0.05 --repetitions "$reps" --metrics
 python3 - <<'PY'
 import time, jax
 jax.config.update("jax_enable_x64", True)
