@@ -49,17 +49,16 @@ def make_run(members, steps, dt, metrics=False):
             a, J = -s * damping, -c * damping
         return m + a * dt, (1.0 + J * dt) ** 2 * P + W
 
-    def draws(key):
+    def truth(key, x):
+        """The truth's Euler-Maruyama step and its observation increment: (key, x after the step, dy)."""
         key, k1, k2 = jax.random.split(key, 3)
         dw = jax.random.normal(k1, (members,), dtype=jnp.float64)
         dv = jax.random.normal(k2, (members,), dtype=jnp.float64)
-        return key, dw, dv
+        return key, x - jnp.sin(x) * dt + Q * sq * dw, x * dt + R * sq * dv
 
     def step(carry, _):
         key, x, ms, Ps = carry
-        key, dw, dv = draws(key)
-        dy = x * dt + R * sq * dv
-        x = x - jnp.sin(x) * dt + Q * sq * dw
+        key, x, dy = truth(key, x)
         out = [update_predict(m, P, dy, kind) for m, P, kind in zip(ms, Ps, kinds)]
         return (key, x, tuple(o[0] for o in out), tuple(o[1] for o in out)), None
 
@@ -74,9 +73,7 @@ def make_run(members, steps, dt, metrics=False):
 
     def scored_step(carry, _):
         key, x, live, filters = carry
-        key, dw, dv = draws(key)
-        dy = x * dt + R * sq * dv
-        moved = x - jnp.sin(x) * dt + Q * sq * dw
+        key, moved, dy = truth(key, x)
         live = live & jnp.isfinite(moved) & jnp.isfinite(dy)
         x = jnp.where(live, moved, x)
         stepped, snapshots, diverged = [], [], []
