@@ -10,6 +10,7 @@
 #include "engine/reference_estimator.hpp"
 #include "engine/shared_instances.hpp"
 #include "engine/truth_bank.hpp"
+#include "kernels/element_gather.hpp"
 #include "kernels/ensemble_moments.hpp"
 #include "kernels/filters/filter_bank_segment.hpp"
 #include "kernels/filters/filter_bank_step.hpp"
@@ -227,6 +228,23 @@ class FilterBank {
     std::vector<double> watched;
   };
   std::vector<SegmentOutput> finish_segment();
+
+  /// The elements of `member` (of this bank) that its trajectory holds, to watch in a segment: the truth's state,
+  /// then each of `filters`' m and P, row by row.
+  std::vector<WatchedElement> member_elements(long member, const std::vector<std::string>& filters) const {
+    std::vector<WatchedElement> elements;
+    const auto add = [&](const auto& view) {
+      for (int i = 0; i < static_cast<int>(view.extent(1)); ++i)
+        elements.push_back({element_address(view, member, i), member});
+    };
+    add(truths_.state());
+    for (const auto& name : filters)
+      with_slot(name, [&](const auto& slot) {
+        add(slot.m);
+        add(slot.P);
+      });
+    return elements;
+  }
 
   const TruthBank<ExecSpace, TruthModel>& truths() const { return truths_; }
   /// (member): non_finite once the member's truth escaped to infinity.

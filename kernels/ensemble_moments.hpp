@@ -143,45 +143,55 @@ __device__ BlockStatistic warp_statistic(const double count, const double sum, c
 /// block_statistic by the 32 lanes of a warp, lane j this thread (each lane adds the values of block_statistic's
 /// lane j): the same sums in the same order, so the same bits up to the multiply-adds nvcc contracts. Each lane
 /// loads its (up to) moment_lane_members values at once and keeps them in registers for the second pass; the lanes
-/// meet by shuffles. A position past the block's end reads the block's last value (so no branch keeps the reads from
-/// going out at once) and adds zero to every sum, as block_statistic's shorter loop adds nothing. As there, a block
-/// whose total is finite takes the passes unmasked (the masked ones would add the same values in the same order),
-/// and the masked passes count only the finite values. (The first team form, which loaded a lane's values one after
-/// another, four at a time as nvcc unrolled the loop, loaded them again for the second pass, and had every thread
-/// add the 32 lanes from team scratch, took 49-67 us for 8 columns of 1e6 members on an H200, 2.8-3.9x a read of
-/// them.)
+/// meet by shuffles. As there, a whole block whose total is finite takes the passes unmasked (the masked ones would add
+/// the same values in the same order), with no test of its positions. A block shorter than moment_block_size (a rank's
+/// last) takes the masked passes, its positions past the end read as NaN: they add zero to every sum, as
+/// block_statistic's shorter loop adds nothing. (Testing every position in the unmasked passes too, with
+/// warp_block_count's tree of double shuffles, cost a GPU segment's output step 388 extra instructions per member-step
+/// against 292 now: perf/filter_bank.md.) A position past the end loads the block's last value (no branch keeps the
+/// reads from going out at once). (The first team form, which loaded a lane's values one after another, four at a time
+/// as nvcc unrolled the loop, loaded them again for the second pass, and had every thread add the 32 lanes from team
+/// scratch, took 49-67 us for 8 columns of 1e6 members on an H200, 2.8-3.9x a read of them.)
 template <class Value>
 __device__ BlockStatistic warp_block_statistic(const int j, const Value& value, const int begin, const int end) {
   constexpr int L = moment_lanes, K = moment_lane_members;
   const int n = end - begin;
-  double v[K], sum = 0.0;
-  KUSHNER_DEVICE_UNROLL
-  for (int k = 0; k < K; ++k) v[k] = value(j + k * L < n ? begin + j + k * L : end - 1);  // no branch
-  KUSHNER_DEVICE_UNROLL
-  for (int k = 0; k < K; ++k) sum += j + k * L < n ? v[k] : 0.0;
-  const double total = warp_pairwise_sum(sum);  // the same on every lane, so the branch below is the warp's
-  if (n > 0 && math::is_finite(total)) {
-    BlockStatistic s;
-    s.count = static_cast<double>(n);
-    // A whole block's mean by a multiply: total / 2^8 and total 2^-8 round the same number, so the same bits, without
-    // a double division's ~40 instructions and their latency between the two passes of every column (output steps of
-    // a GPU segment x1.012: perf/filter_bank.md).
-    static_assert((moment_block_size & (moment_block_size - 1)) == 0, "a power of two");
-    s.mean = n == moment_block_size ? total * (1.0 / moment_block_size) : total / s.count;
-    double ss = 0.0;
+  double v[K];
+  if (n == moment_block_size) {
+    double sum = 0.0;
+    KUSHNER_DEVICE_UNROLL
+    for (int k = 0; k < K; ++k) v[k] = value(begin + j + k * L);
+    KUSHNER_DEVICE_UNROLL
+    for (int k = 0; k < K; ++k) sum += v[k];
+    const double total = warp_pairwise_sum(sum);  // the same on every lane, so the branch below is the warp's
+    if (math::is_finite(total)) {
+      BlockStatistic s;
+      s.count = static_cast<double>(n);
+      // The mean by a multiply: total / 2^8 and total 2^-8 round the same number, so the same bits, without a double
+      // division's ~40 instructions and their latency between the two passes of every column (output steps of a GPU
+      // segment x1.012: perf/filter_bank.md).
+      static_assert((moment_block_size & (moment_block_size - 1)) == 0, "a power of two");
+      s.mean = total * (1.0 / moment_block_size);
+      double ss = 0.0;
+      KUSHNER_DEVICE_UNROLL
+      for (int k = 0; k < K; ++k) {
+        const double d = v[k] - s.mean;
+        ss += d * d;
+      }
+      s.m2 = warp_pairwise_sum(ss);
+      return s;
+    }
+  } else {
     KUSHNER_DEVICE_UNROLL
     for (int k = 0; k < K; ++k) {
-      const double d = j + k * L < n ? v[k] - s.mean : 0.0;
-      ss += d * d;
+      const bool in = j + k * L < n;
+      v[k] = value(in ? begin + j + k * L : end - 1);  // no branch
+      if (!in) v[k] = math::quiet_nan();
     }
-    s.m2 = warp_pairwise_sum(ss);
-    return s;
   }
-  double count = 0.0;
-  sum = 0.0;
+  double count = 0.0, sum = 0.0;
   KUSHNER_DEVICE_UNROLL
   for (int k = 0; k < K; ++k) {
-    if (j + k * L >= n) v[k] = math::quiet_nan();
     const bool finite = math::is_finite(v[k]);
     count += finite ? 1.0 : 0.0;
     sum += finite ? v[k] : 0.0;
@@ -200,7 +210,8 @@ __device__ BlockStatistic warp_block_statistic(const int j, const Value& value, 
 /// The members m in [begin, end) with counted(m), by the 32 lanes of a warp (lane j this thread, its members as in
 /// warp_block_statistic). A position past the end asks about the block's last member and is not counted, so every
 /// lane's reads are unconditional and go out at once (nvcc kept a branch before each read of a && chain: one read at
-/// a time). An integer: any order gives the same count.
+/// a time). An integer: any order gives the same count, so the lanes meet in one warp reduction (sm_80 and newer, as
+/// every target of a CUDA build) rather than a tree of double shuffles.
 template <class Counted>
 __device__ int warp_block_count(const int j, const Counted& counted, const int begin, const int end) {
   bool in[moment_lane_members], yes[moment_lane_members];
@@ -210,10 +221,10 @@ __device__ int warp_block_count(const int j, const Counted& counted, const int b
     in[k] = m < end;
     yes[k] = counted(in[k] ? m : end - 1);
   }
-  double count = 0.0;  // exact: at most moment_block_size
+  unsigned count = 0;
   KUSHNER_DEVICE_UNROLL
-  for (int k = 0; k < moment_lane_members; ++k) count += in[k] && yes[k] ? 1.0 : 0.0;
-  return static_cast<int>(warp_pairwise_sum(count));
+  for (int k = 0; k < moment_lane_members; ++k) count += in[k] && yes[k] ? 1u : 0u;
+  return static_cast<int>(__reduce_add_sync(0xffffffffu, count));
 }
 #endif
 

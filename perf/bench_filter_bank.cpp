@@ -2,7 +2,6 @@
 // second, next to the truth step alone in the same binary. ASRE runs a fixed 8 iterates per member (its
 // convergence passes are not part of a step; the seed models need 5-8 on average at tolerance 1e-6).
 #include "engine/filter_bank.hpp"
-#include "kernels/element_gather.hpp"
 #include "kernels/filters/filter_list.hpp"
 #include "models/cubic_oscillator_model.hpp"
 #include "models/sine_model.hpp"
@@ -88,17 +87,9 @@ void BM_FilterBankSegments(benchmark::State& state) {
   using Bank = FilterBank<Space, Model>;
   Bank bank(space, Model{}, Model{}, members, 42, filters);
   std::vector<WatchedElement> watched;
-  const auto watch = [&](const auto& view, long member) {
-    for (int i = 0; i < static_cast<int>(view.extent(1)); ++i)
-      watched.push_back({element_address(view, member, i), member});
-  };
   for (long member = 0; member < (state.range(2) != 0 ? 3 : 0); ++member) {
-    watch(bank.truths().state(), member);
-    for (const auto& name : filters)
-      bank.with_slot(name, [&](const auto& slot) {
-        watch(slot.m, member);
-        watch(slot.P, member);
-      });
+    const std::vector<WatchedElement> e = bank.member_elements(member, filters);
+    watched.insert(watched.end(), e.begin(), e.end());
   }
   const std::vector<char> outputs(Bank::segment_steps, output ? 1 : 0);
   long k = 0;

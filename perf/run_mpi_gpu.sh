@@ -7,6 +7,12 @@
 #          strong scaling M = 2000 on 1 GPU against 2 GPUs: speedup t1 / t2
 #          the M = 2000 outputs of 1 and 2 ranks: every number equal to 1e-12 relative (and whether the bytes are)
 #          On a machine with one GPU the two ranks share it; the summary says so.
+#   segments `kushner compare --filters EKF,SOF,QLF,KBL` (no PF: the bank takes its steps in segments, the team form
+#          on a GPU), M = 8000 (a last block of 64 members), members 0, 1, 2, 5000, 7999 recorded (on ranks 0, 1 and the
+#          last), on 1, 2 and 3 ranks: every number of timeseries.csv, trajectories.csv and summary.json equal to
+#          1e-12 relative to 1 rank's, and whether the files' bytes below their command line are the same
+# KUSHNER_MPI_GPU_ONLY=1: the build for the GPU alone (no OpenMP backend; Ninja where the image has it): about 6
+# minutes of 16 cores, where the build with OpenMP needs more than one call.
 # Each timing is the wall time of the whole command (start-up, CUDA context, run, outputs), best of
 # KUSHNER_REPETITIONS (default 2). Power and SM clock of every GPU are sampled every 500 ms while it runs.
 #   OUT=<dir> KUSHNER_PHASES="build run" perf/run_mpi_gpu.sh
@@ -31,8 +37,14 @@ cat "$out/gpu.csv" "$out/mpirun.txt"
 if want build; then
   log "configure"
   # perf/gpu_machine.cmake: the models' banks and commands spread over more units than the default (16-32 cores).
-  cmake -C "$here/perf/gpu_machine.cmake" -S "$here" -B "$build" \
-    -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON -DKUSHNER_ENABLE_OPENMP=ON \
+  backends=(-DKUSHNER_ENABLE_OPENMP=ON)
+  if [ -n "${KUSHNER_MPI_GPU_ONLY:-}" ]; then
+    ninja=$(command -v ninja || ls /opt/torch/.venv/bin/ninja 2> /dev/null | head -1)
+    backends=(-DKUSHNER_ENABLE_OPENMP=OFF -DKUSHNER_ENABLE_SERIAL=ON -DKUSHNER_GPU_BACKEND_ONLY=ON)
+    [ -n "$ninja" ] && backends+=(-G Ninja -DCMAKE_MAKE_PROGRAM="$ninja")
+  fi
+  cmake "${backends[@]}" -C "$here/perf/gpu_machine.cmake" -S "$here" -B "$build" \
+    -DCMAKE_BUILD_TYPE=Release -DKUSHNER_ENABLE_CUDA=ON \
     -DKUSHNER_ENABLE_MPI=ON -DKUSHNER_ENABLE_TESTS=OFF -DKUSHNER_ENABLE_BENCHMARKS=OFF \
     > "$out/configure.log" 2>&1 || { tail -20 "$out/configure.log"; exit 1; }
   grep "mpi=" "$out/configure.log"
@@ -75,7 +87,7 @@ if want run; then
     grep -iv "compiled for compute capability 8.0" "$f" | grep -i "error\|warning" | sed "s|^|$(basename "$f"): |"
   done
   python3 - "$out" "$gpus" "$strong_r2" "$T" <<'PY' | tee "$out/summary.txt" || status=1
-import json, math, os, sys
+import json, os, sys
 out, gpus, strong_r2 = sys.argv[1], int(sys.argv[2]), sys.argv[3]
 t = lambda name: float(open(os.path.join(out, name + ".time")).read())
 steps, particles = round(float(sys.argv[4]) * 1000), 65536
@@ -91,42 +103,11 @@ loop = lambda name: json.load(open(os.path.join(out, name, "summary.json")))["ti
 l_w1, l_s1, l_s2 = loop("weak_r1_m1000"), loop("strong_r1_m2000"), loop(strong_r2)
 print(f"step loop: M = 1000 on 1 rank {l_w1:.3f} s, M = 2000 on 1 rank {l_s1:.3f} s, on 2 ranks {l_s2:.3f} s: "
       f"weak efficiency {l_w1 / l_s2:.3f}, strong speedup {l_s1 / l_s2:.3f}")
-
-def numbers(path):  # every number of timeseries.csv, row by row
-    rows = [l.rstrip("\n").split(",") for l in open(path) if not l.startswith("#")]
-    return rows[0], rows[1:]
-a_dir, b_dir = os.path.join(out, "strong_r1_m2000"), os.path.join(out, strong_r2)
-header, a = numbers(os.path.join(a_dir, "timeseries.csv"))
-_, b = numbers(os.path.join(b_dir, "timeseries.csv"))
-worst = 0.0
-for ra, rb in zip(a, b):
-    assert ra[:2] == rb[:2], (ra[:2], rb[:2])
-    for x, y in zip(map(float, ra[2:]), map(float, rb[2:])):
-        if math.isnan(x) and math.isnan(y):
-            continue
-        worst = max(worst, abs(x - y) / max(abs(x), abs(y), 1e-300))
-sa, sb = (json.load(open(os.path.join(d, "summary.json"))) for d in (a_dir, b_dir))
-def flat(j, prefix=""):
-    if isinstance(j, dict):
-        for k, v in j.items():
-            if k not in ("backend", "command", "timing"):
-                yield from flat(v, prefix + "." + k)
-    elif isinstance(j, (int, float)) and not isinstance(j, bool):
-        yield prefix, float(j)
-fa, fb = dict(flat(sa)), dict(flat(sb))
-assert fa.keys() == fb.keys(), set(fa) ^ set(fb)
-for k in fa:
-    x, y = fa[k], fb[k]
-    if not (math.isnan(x) and math.isnan(y)):
-        worst = max(worst, abs(x - y) / max(abs(x), abs(y), 1e-300))
-# Line 1 is the comment with the command, whose --out differs.
-data = lambda d: open(os.path.join(d, "timeseries.csv"), "rb").read().split(b"\n", 1)[1]
-same_bytes = data(a_dir) == data(b_dir)
-print(f"R = 1 vs R = 2 (M = 2000): largest relative difference {worst:.3g} over timeseries.csv and summary.json "
-      f"(goal <= 1e-12); timeseries.csv byte-identical below its command line: {same_bytes}")
-print("backend R = 2:", json.dumps(sb["backend"]))
-sys.exit(0 if worst <= 1e-12 else 1)
+print("backend R = 2:", json.dumps(json.load(open(os.path.join(out, strong_r2, "summary.json")))["backend"]))
 PY
+  # The M = 2000 outputs of 1 and 2 ranks: every number equal to 1e-12 relative, and whether the bytes are the same.
+  same=$(python3 "$here/perf/compare_outputs.py" "$out/strong_r1_m2000" "$out/$strong_r2") || status=1
+  echo "R = 1 vs R = 2 (M = 2000): $same" | tee -a "$out/summary.txt"
   python3 - "$out/power.csv" <<'PY' | tee -a "$out/summary.txt"
 import csv, sys
 rows = list(csv.reader(open(sys.argv[1])))[1:]
@@ -141,6 +122,21 @@ for gpu, v in sorted(by.items()):
     print(f"GPU {gpu}: while busy (>50% utilization, {len(busy)} samples) power {max(x[0] for x in busy):.0f} W max, "
           f"SM clock {min(x[1] for x in busy):.0f}-{max(x[1] for x in busy):.0f} MHz")
 PY
+fi
+if want segments; then
+  [ -x "$build/kushner" ] || { echo "no $build/kushner: run the build phase first" >&2; exit 1; }
+  for ranks in 1 2 3; do
+    rm -rf "$out/segments_r$ranks"
+    KUSHNER_BACKEND=cuda mpirun -q --bind-to none --oversubscribe -np "$ranks" "$build/kushner" compare --model sine \
+      --filters EKF,SOF,QLF,KBL --members 8000 --T 0.1 --seed 5 --trajectory-members 0,1,2,5000,7999 --no-plots \
+      --quiet --out "$out/segments_r$ranks" > "$out/segments_r$ranks.log" 2>&1 ||
+      { status=1; tail -3 "$out/segments_r$ranks.log"; }
+  done
+  for ranks in 2 3; do
+    same=$(python3 "$here/perf/compare_outputs.py" "$out/segments_r1" "$out/segments_r$ranks" timeseries.csv \
+      trajectories.csv) || status=1
+    echo "segments, R = $ranks against R = 1 (M = 8000, 5 recorded members): $same" | tee -a "$out/summary.txt"
+  done
 fi
 log "done (status $status)"
 exit $status

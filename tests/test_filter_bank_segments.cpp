@@ -9,7 +9,6 @@
 // form (a GPU's segments), on the host and, where the build has one, on the device. Then run_filters, which takes
 // segments from 4096 members, against a bank stepped by hand.
 #include "engine/filter_run.hpp"
-#include "kernels/element_gather.hpp"
 #include "kernels/filters/filter_list.hpp"
 #include "models/cubic_sensor_model.hpp"
 #include "models/linear_discrete_model.hpp"
@@ -95,17 +94,6 @@ std::vector<double> member_values(const Bank& bank, const std::vector<std::strin
   return values;
 }
 
-/// member_values' elements (element_address), in its order: what a segment copies at each output step.
-template <class Bank>
-std::vector<WatchedElement> member_elements(const Bank& bank, const std::vector<std::string>& filters, long member) {
-  std::vector<WatchedElement> elements;
-  for_each_observed_view(bank, filters, [&](const auto& view) {
-    for (int i = 0; i < static_cast<int>(view.extent(1)); ++i)
-      elements.push_back({element_address(view, member, i), member});
-  });
-  return elements;
-}
-
 /// Steps [0, sum of `segments`) with output steps at the ends of steps `output_ends` (k + 1 for step k), one step at a
 /// time and in segments of the given sizes, members `watched` read at each output time (a segment copies their
 /// elements as it takes an output step); then everything compared:
@@ -144,7 +132,7 @@ void expect_segments_match_steps(const Model& model, const std::vector<std::stri
   std::vector<std::vector<double>> segment_watched;
   std::vector<WatchedElement> elements;
   for (const long member : watched) {
-    const std::vector<WatchedElement> e = member_elements(segmented, filters, member);
+    const std::vector<WatchedElement> e = segmented.member_elements(member, filters);
     elements.insert(elements.end(), e.begin(), e.end());
   }
   const auto finish_segment = [&] {
@@ -274,7 +262,7 @@ TEST(FilterBankSegments, RunFiltersTakesSegmentsWithTheNumbersOfStepsOneAtATime)
       [&](const Bank& bank) {
         std::vector<WatchedElement> elements;
         for (const long m : watched) {
-          const std::vector<WatchedElement> e = member_elements(bank, filters, m);
+          const std::vector<WatchedElement> e = bank.member_elements(m, filters);
           elements.insert(elements.end(), e.begin(), e.end());
         }
         return elements;
