@@ -9,6 +9,7 @@
 // the run.
 #include "core/collectives.hpp"
 #include "core/errors.hpp"
+#include "core/math.hpp"
 #include "drivers/csv.hpp"
 #include "drivers/run_metadata.hpp"
 #include "engine/filter_bank.hpp"
@@ -78,15 +79,13 @@ class TrajectoryRecorder {
       if (snapshot) pf = e;
     }
     const bool density = pf && next_density_ < density_times_.size() && t >= density_times_[next_density_] - 1e-9;
-    // First pass: what the rows read; then one gather (unless the values came with the call); then the rows.
-    const std::vector<WatchedElement> read_elements = elements(bank, outside, pf);
+    // Unless the values came with the call (a segment copied elements(bank)): a first pass for what the rows read,
+    // and one gather. Then the rows, which must read every value once.
     if (values == nullptr) {
       std::vector<std::uintptr_t> addresses;
-      for (const WatchedElement& e : read_elements) addresses.push_back(e.address);
+      for (const WatchedElement& e : elements(bank, outside, pf)) addresses.push_back(e.address);
       values = &gather_(ExecSpace(), addresses);
     }
-    KUSHNER_REQUIRE(values->size() == read_elements.size(),
-                    "TrajectoryRecorder: " << values->size() << " values for " << read_elements.size() << " elements");
     ElementReader read{nullptr, values};
     for (long member : members_) {
       std::string rows;
@@ -94,6 +93,8 @@ class TrajectoryRecorder {
         rows = trajectory_rows(t, member, member - share_.first, bank, outside, pf, snapshot, read);
       trajectories_ += collective::broadcast(rows, member_owner(member, share_.total));
     }
+    KUSHNER_REQUIRE(read.next == values->size(),
+                    "TrajectoryRecorder: " << values->size() << " values for " << read.next << " elements read");
     if (density) {
       while (next_density_ < density_times_.size() && t >= density_times_[next_density_] - 1e-9) ++next_density_;
       const long member = members_.front();
@@ -181,7 +182,10 @@ class TrajectoryRecorder {
     std::size_t next = 0;
     template <class View>
     double operator()(const View& v, long local, int column) {
-      if (record == nullptr) return (*values)[next++];
+      if (record == nullptr) {
+        const std::size_t i = next++;
+        return i < values->size() ? (*values)[i] : math::quiet_nan();  // too few: operator() refuses after the rows
+      }
       record->push_back({element_address(v, local, column), local});
       return 0.0;
     }

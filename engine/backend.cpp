@@ -36,14 +36,18 @@ void require_usable_gpu() {
 #endif
 }
 
-/// The GPU this process runs on: its local rank's, round robin over the node's GPUs (two ranks may share one).
-int rank_gpu() {
+/// The node's GPUs as the CUDA runtime counts them (1 where it counts none, or in a build without CUDA): what the
+/// ranks' GPUs (rank_gpu) and the ranks sharing one's memory (ranks_sharing_memory) are counted from.
+int node_gpus() {
   int devices = 1;
 #if defined(KOKKOS_ENABLE_CUDA)
   if (cudaGetDeviceCount(&devices) != cudaSuccess || devices < 1) devices = 1;
 #endif
-  return local_rank() % devices;
+  return devices;
 }
+
+/// The GPU this process runs on: its local rank's, round robin over the node's GPUs (two ranks may share one).
+int rank_gpu() { return local_rank() % node_gpus(); }
 
 }  // namespace
 
@@ -123,13 +127,7 @@ void set_openmp_threads(unsigned threads) {
 }  // namespace
 
 int ranks_sharing_memory(const std::string& name) {
-  int devices = 1;
-#if defined(KOKKOS_ENABLE_CUDA)
-  if (name == "cuda" && (cudaGetDeviceCount(&devices) != cudaSuccess || devices < 1)) devices = 1;
-  if (name != "cuda") devices = 1;
-#else
-  (void)name;
-#endif
+  const int devices = name == "cuda" ? node_gpus() : 1;
   return (local_ranks() + devices - 1) / devices;
 }
 
