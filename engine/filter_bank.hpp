@@ -229,8 +229,9 @@ class FilterBank {
   };
   std::vector<SegmentOutput> finish_segment();
 
-  /// The elements of `member` (of this bank) that its trajectory holds, to watch in a segment: the truth's state,
-  /// then each of `filters`' m and P, row by row.
+  /// The elements of `member` (of this bank) to watch in a segment (start_segment): the truth's state, then each of
+  /// `filters`' m and every packed entry of P, row by row. (The trajectory recorder watches its own list: the means and
+  /// variances its rows read.)
   std::vector<WatchedElement> member_elements(long member, const std::vector<std::string>& filters) const {
     std::vector<WatchedElement> elements;
     const auto add = [&](const auto& view) {
