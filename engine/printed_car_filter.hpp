@@ -16,6 +16,7 @@
 
 #include <Kokkos_Core.hpp>
 
+#include <cstdint>
 #include <string>
 
 namespace kushner {
@@ -29,12 +30,13 @@ struct PrintedCarFilterStep {
   BankSymmetric<MemSpace> P;
   BankScalar<Status, MemSpace> status;
   double t, dt;
+  std::uint32_t step;
 
   KOKKOS_INLINE_FUNCTION void operator()(const int member) const {
     if (status(member) != Status::ok) return;
     Vec<2> mm = load<2>(m, member);
     Mat<2, 2> Pm = load_symmetric<2>(P, member);
-    const StepInput<2> in{t, dt, load<2>(dy, member), Mat<2, 2>::identity()};
+    const StepInput<2> in{t, dt, step, load<2>(dy, member), Mat<2, 2>::identity()};
     Vec<2> weighted_innovation;
     if (!kalman_update(ObservationLinearization<2, 2>{mm, Mat<2, 2>::identity()}, in, mm, Pm, weighted_innovation)) {
       status(member) = Status::not_positive_definite;
@@ -88,9 +90,10 @@ class PrintedCarFilter final : public ReferenceEstimator<typename ExecSpace::mem
   }
 
   std::string name() const override { return "POLY3-21"; }
-  void advance(long, double t, double dt, const BankVector<MemSpace>& dy) override {
+  void advance(long k, double t, double dt, const BankVector<MemSpace>& dy) override {
     parallel_for_members("kushner::printed_car_filter_step", space_, m_.extent(0),
-                         detail::PrintedCarFilterStep<MemSpace>{v_over_l_, u_, dy, m_, P_, status_, t, dt});
+                         detail::PrintedCarFilterStep<MemSpace>{v_over_l_, u_, dy, m_, P_, status_, t, dt,
+                                                                static_cast<std::uint32_t>(k)});
   }
   BankVector<MemSpace> mean() const override { return m_; }
   BankSymmetric<MemSpace> covariance() const override { return P_; }

@@ -69,7 +69,7 @@ struct ClosedLoopStep {
     }
     if (source != EstimateSource::bank_filter) return;
     const Mat<p, p> R = model.observation_noise(truth.t);
-    const StepInput<p> in{truth.t, truth.dt, dy, R * transpose(R)};
+    const StepInput<p> in{truth.t, truth.dt, truth.step, dy, R * transpose(R)};
     // The known input: B u dt of the Euler step, or a discrete step's B u (kernels/filters/filter_slot.hpp).
     const Vec<n> shift = model.control_input(truth.t) * u * (Model::discrete_time ? 1.0 : truth.dt);
     (advance(static_cast<const FilterSlot<Filters, MemSpace>&>(slots), model, member, in, next, record, shift), ...);

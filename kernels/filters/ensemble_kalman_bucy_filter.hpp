@@ -103,7 +103,7 @@ struct EnsembleKalmanBucyBase {
   KOKKOS_INLINE_FUNCTION Status step(const Model& model, int member, const StepInput<p>& in, Vec<n>& m,
                                      Mat<n, n>& P) const {
     const int N = num_particles;
-    const auto step_index = static_cast<std::uint32_t>(in.t / in.dt + 0.5);
+    const std::uint32_t step_index = in.step;
     const auto who = static_cast<std::uint32_t>(member);
     // Ensemble statistics at the step's start: x_bar, h_bar, P^{xh}, P^{hh} (two passes: means, then spreads).
     Vec<n> x_bar = Vec<n>::zero();

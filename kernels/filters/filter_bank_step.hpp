@@ -74,7 +74,7 @@ struct FilterBankStep {
       return;
     }
     const Mat<p, p> R = model.observation_noise(at);
-    const StepInput<p> in{at, truth.dt, dy, R * transpose(R)};
+    const StepInput<p> in{at, truth.dt, k, dy, R * transpose(R)};
     (advance(static_cast<const FilterSlot<Filters, MemSpace>&>(slots), model, member, in, x, at_output), ...);
   }
 
@@ -137,7 +137,7 @@ struct FilterBankStep {
           if (record) mark_unscored(slot, member);
           continue;
         }
-        const StepInput<p> in{truth.t, truth.dt, load<p>(truth.dy, member), V};
+        const StepInput<p> in{truth.t, truth.dt, truth.step, load<p>(truth.dy, member), V};
         advance(slot, model, member, in, load<n>(truth.x, member), record);
       }
     }
@@ -174,7 +174,7 @@ struct FilterBankStep {
       status[member - begin] =
           advance_lane(filter, lane_model, m, m_stride, P, P_stride, score, score_stride, error + (member - begin),
                        nees + (member - begin), status[member - begin], member, live[member - begin] != 0, t, dt,
-                       lane_V, xs, x_stride, dys, dy_stride);
+                       truth.step, lane_V, xs, x_stride, dys, dy_stride);
     for (int member = begin; member < end; ++member) slot.status(member) = static_cast<Status>(status[member - begin]);
     if constexpr (Record) {
       // The reference column is not touched: with a reference, its score (FilterBankReferenceScore, after the step

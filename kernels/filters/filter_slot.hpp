@@ -214,7 +214,7 @@ KOKKOS_INLINE_FUNCTION std::int64_t advance_lane(const Filter& filter, const Mod
                                                  const std::size_t P_stride, double* const score,
                                                  const std::size_t score_stride, double* const lane_error,
                                                  double* const lane_nees, const std::int64_t old_status, int member,
-                                                 bool live, double t, double dt,
+                                                 bool live, double t, double dt, std::uint32_t step,
                                                  const Mat<Model::obs_dim, Model::obs_dim>& V, const double* x,
                                                  std::size_t x_stride, const double* dy, std::size_t dy_stride) {
   constexpr int n = Model::state_dim, p = Model::obs_dim;
@@ -229,7 +229,7 @@ KOKKOS_INLINE_FUNCTION std::int64_t advance_lane(const Filter& filter, const Mod
   for (int i = 0; i < n; ++i) xm[i] = x[member + i * x_stride];
   for (int l = 0; l < p; ++l) dyv[l] = dy[member + l * dy_stride];
   // The status as a 64-bit integer: a one-byte value in the loop would make GCC take 64 lanes at a time.
-  std::int64_t status = static_cast<std::int64_t>(filter.step(model, member, StepInput<p>{t, dt, dyv, V}, m, P));
+  std::int64_t status = static_cast<std::int64_t>(filter.step(model, member, StepInput<p>{t, dt, step, dyv, V}, m, P));
   constexpr auto ok = static_cast<std::int64_t>(Status::ok);
   m += Vec<n>::zero();  // advance()'s control shift in an open loop
   if (status == ok && !(all_finite(m) && all_finite(P))) status = static_cast<std::int64_t>(Status::non_finite);

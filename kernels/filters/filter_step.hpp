@@ -17,16 +17,22 @@
 #include "core/small_matrix.hpp"
 #include "core/status.hpp"
 
+#include <cstdint>
+
 namespace kushner {
 
 /// Pivots within this fraction of the largest variance count as zero (core/linear_algebra.hpp).
 constexpr double covariance_tolerance = 1e-10;
 
-/// What one step of one member gives every filter. A discrete-time model's step k: t = k, dt = 1, dy = z[k+1],
-/// V = Cov v.
+/// What one step of one member gives every filter: step k from t = k dt. A discrete-time model's step k: t = k, dt =
+/// 1, dy = z[k+1], V = Cov v. `step` keys the random numbers of a filter that draws them (EnKBF): taken from t / dt, a
+/// double division, it was computed at every member-step of a bank's GPU step, EnKBF in the bank or not (nvcc hoisted
+/// it above the slots' tests, EnKBF and EnKBF-S sharing it; the sine bank's steps x1.03-1.04 without it on an H200:
+/// perf/filter_bank.md).
 template <int P>
 struct StepInput {
   double t, dt;
+  std::uint32_t step;
   Vec<P> dy;
   Mat<P, P> V;  // R R^T at t
 };

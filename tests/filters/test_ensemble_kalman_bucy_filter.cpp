@@ -140,7 +140,7 @@ double largest_difference_from_written_out_step(const Model& model) {
   Vec<p> dy;
   for (int j = 0; j < p; ++j) dy[j] = 0.01 * (j + 1);
   const Mat<p, p> R = model.observation_noise(step * dt);
-  const StepInput<p> in{step * dt, dt, dy, R * transpose(R)};
+  const StepInput<p> in{step * dt, dt, static_cast<std::uint32_t>(step), dy, R * transpose(R)};
   Vec<n> m = Vec<n>::zero();
   Mat<n, n> P = Mat<n, n>::zero();
   EXPECT_EQ(filter.step(model, member, in, m, P), Status::ok);
