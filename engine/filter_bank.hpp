@@ -229,21 +229,24 @@ class FilterBank {
   };
   std::vector<SegmentOutput> finish_segment();
 
-  /// The elements of `member` (of this bank) to watch in a segment (start_segment): the truth's state, then each of
-  /// `filters`' m and every packed entry of P, row by row. (The trajectory recorder watches its own list: the means and
-  /// variances its rows read.)
-  std::vector<WatchedElement> member_elements(long member, const std::vector<std::string>& filters) const {
+  /// The elements of `members` (of this bank) to watch in a segment (start_segment), member by member: the truth's
+  /// state, then each of `filters`' m and every packed entry of P, row by row. (The trajectory recorder watches its own
+  /// list: the means and variances its rows read.)
+  std::vector<WatchedElement> member_elements(const std::vector<long>& members,
+                                              const std::vector<std::string>& filters) const {
     std::vector<WatchedElement> elements;
-    const auto add = [&](const auto& view) {
-      for (int i = 0; i < static_cast<int>(view.extent(1)); ++i)
-        elements.push_back({element_address(view, member, i), member});
-    };
-    add(truths_.state());
-    for (const auto& name : filters)
-      with_slot(name, [&](const auto& slot) {
-        add(slot.m);
-        add(slot.P);
-      });
+    for (const long member : members) {
+      const auto add = [&](const auto& view) {
+        for (int i = 0; i < static_cast<int>(view.extent(1)); ++i)
+          elements.push_back({element_address(view, member, i), member});
+      };
+      add(truths_.state());
+      for (const auto& name : filters)
+        with_slot(name, [&](const auto& slot) {
+          add(slot.m);
+          add(slot.P);
+        });
+    }
     return elements;
   }
 

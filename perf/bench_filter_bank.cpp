@@ -86,11 +86,8 @@ void BM_FilterBankSegments(benchmark::State& state) {
   const std::vector<std::string> filters{"EKF", "SOF", "QLF", "KBL"};
   using Bank = FilterBank<Space, Model>;
   Bank bank(space, Model{}, Model{}, members, 42, filters);
-  std::vector<WatchedElement> watched;
-  for (long member = 0; member < (state.range(2) != 0 ? 3 : 0); ++member) {
-    const std::vector<WatchedElement> e = bank.member_elements(member, filters);
-    watched.insert(watched.end(), e.begin(), e.end());
-  }
+  const std::vector<WatchedElement> watched =
+      bank.member_elements(state.range(2) != 0 ? std::vector<long>{0, 1, 2} : std::vector<long>{}, filters);
   const std::vector<char> outputs(Bank::segment_steps, output ? 1 : 0);
   long k = 0;
   for (auto _ : state) {

@@ -130,11 +130,7 @@ void expect_segments_match_steps(const Model& model, const std::vector<std::stri
   // half of the team form's buffers).
   std::vector<std::vector<FilterSnapshot>> segment_snapshots;
   std::vector<std::vector<double>> segment_watched;
-  std::vector<WatchedElement> elements;
-  for (const long member : watched) {
-    const std::vector<WatchedElement> e = segmented.member_elements(member, filters);
-    elements.insert(elements.end(), e.begin(), e.end());
-  }
+  const std::vector<WatchedElement> elements = segmented.member_elements(watched, filters);
   const auto finish_segment = [&] {
     for (const auto& output : segmented.finish_segment()) {
       segment_snapshots.push_back(output.snapshots);
@@ -259,14 +255,7 @@ TEST(FilterBankSegments, RunFiltersTakesSegmentsWithTheNumbersOfStepsOneAtATime)
         seen.push_back(values ? *values : watched_values(bank));
         copied_by_segments += values ? 1 : 0;
       },
-      [&](const Bank& bank) {
-        std::vector<WatchedElement> elements;
-        for (const long m : watched) {
-          const std::vector<WatchedElement> e = bank.member_elements(m, filters);
-          elements.insert(elements.end(), e.begin(), e.end());
-        }
-        return elements;
-      }};
+      [&](const Bank& bank) { return bank.member_elements(watched, filters); }};
   const FilterReport report =
       run_filters(Space(), SineModel{}, SineModel{}, members, seed, grid, filters, {}, {}, {}, observer);
 
