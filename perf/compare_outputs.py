@@ -3,10 +3,11 @@
 
     perf/compare_outputs.py DIR_A DIR_B [FILE.csv ...]   (default: timeseries.csv)
 
-Prints, per file, its rows, the largest relative difference of its numbers (NaN equals NaN; text fields must match)
-and whether its bytes below the first line (the comment with the command, whose --out differs) are the same; then
-summary.json's numbers (all but backend, command and timing, which differ between backends and rank counts). Exit 1
-when a difference exceeds --tolerance (default 1e-12), a file's rows or text differ, or summary.json's keys differ.
+Prints, per file, its rows, the largest relative difference of its numbers (NaN equals NaN; the header, the text fields
+and the key columns, a row's time, member and component, must match as written) and whether its bytes below the first
+line (the comment with the command, whose --out differs) are the same; then summary.json's numbers (all but backend,
+command and timing, which differ between backends and rank counts). Exit 1 when a difference exceeds --tolerance
+(default 1e-12), a file's rows or text differ, or summary.json's keys differ.
 """
 import argparse
 import json
@@ -15,8 +16,12 @@ import os
 import sys
 
 
-def rows(path):
-    return [line.rstrip("\n").split(",") for line in open(path) if not line.startswith("#")][1:]
+KEYS = ("t", "member", "component")  # what a row is about: equal as written, not within a tolerance
+
+
+def header_and_rows(path):
+    lines = [line.rstrip("\n").split(",") for line in open(path) if not line.startswith("#")]
+    return lines[0], lines[1:]
 
 
 def field(x):
@@ -50,13 +55,15 @@ def main():
     args = parser.parse_args()
     worst, ok, lines = 0.0, True, []
     for name in args.files:
-        ra, rb = rows(os.path.join(args.a, name)), rows(os.path.join(args.b, name))
+        (ha, ra), (hb, rb) = (header_and_rows(os.path.join(d, name)) for d in (args.a, args.b))
         file_worst = 0.0
-        if len(ra) != len(rb) or not ra:
+        if ha != hb or len(ra) != len(rb) or not ra:
             ok = False
-            lines.append("%s: %d rows against %d" % (name, len(ra), len(rb)))
+            lines.append("%s: header or number of rows differ (%d rows against %d)" % (name, len(ra), len(rb)))
             continue
+        keys = {i for i, column in enumerate(ha) if column in KEYS}
         for x_row, y_row in zip(ra, rb):
+            ok = ok and len(x_row) == len(y_row) and all(x_row[i] == y_row[i] for i in keys if i < len(x_row))
             for x, y in zip(map(field, x_row), map(field, y_row)):
                 if isinstance(x, str) or isinstance(y, str):
                     ok = ok and x == y
