@@ -100,9 +100,15 @@ template <class Model, class MemSpace>
 struct EulerMaruyamaTruthStep {
   Model model;
   BankVector<MemSpace> x, dy;
-  double t, dt;
-  Seed seed;
-  std::uint32_t step;
+  double t = 0.0, dt = 0.0;
+  Seed seed{};
+  std::uint32_t step = 0;
+  double sqrt_dt = 0.0;  // sqrt(dt), once per step: each member-step took a double square root (~20 instructions)
+
+  EulerMaruyamaTruthStep() = default;
+  EulerMaruyamaTruthStep(const Model& model_, const BankVector<MemSpace>& x_, const BankVector<MemSpace>& dy_,
+                         const double t_, const double dt_, const Seed seed_, const std::uint32_t step_)
+      : model(model_), x(x_), dy(dy_), t(t_), dt(dt_), seed(seed_), step(step_), sqrt_dt(math::sqrt(dt_)) {}
 
   KOKKOS_INLINE_FUNCTION void operator()(const int member) const { step_member(member, Model::Control::zero()); }
 
@@ -135,7 +141,6 @@ struct EulerMaruyamaTruthStep {
                                             const Vec<Model::obs_dim>& zv, Vec<Model::state_dim>& next,
                                             Vec<Model::obs_dim>& increment) const {
     constexpr int p = Model::obs_dim;
-    const double sqrt_dt = math::sqrt(dt);
     const auto dw = zw * sqrt_dt;
     Vec<p> dv;
     if (sine_observation_noise(model))

@@ -17,6 +17,7 @@ namespace kushner {
 struct BenesModel : InitialLaw<1> {
   static constexpr int state_dim = 1, obs_dim = 1, noise_dim = 1, control_dim = 0;
   static constexpr bool discrete_time = false;
+  static constexpr bool time_invariant = true;  // f, G, h, R: no function of t
   static constexpr bool linear_observation = true;
   static constexpr const char* name = "benes";
   static constexpr const char* description = "Benes: dx = tanh(x) dt + dw, dy = x dt + r dv (exact filter known)";

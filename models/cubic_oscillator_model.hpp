@@ -16,6 +16,7 @@ namespace kushner {
 struct CubicOscillatorModel : InitialLaw<2> {
   static constexpr int state_dim = 2, obs_dim = 2, noise_dim = 1, control_dim = 1;
   static constexpr bool discrete_time = false;
+  static constexpr bool time_invariant = true;  // f, G, h, R: no function of t
   static constexpr bool linear_observation = true;
   static constexpr const char* name = "cubic-oscillator";
   static constexpr const char* description =

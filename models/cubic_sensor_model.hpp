@@ -14,6 +14,7 @@ namespace kushner {
 struct CubicSensorModel : InitialLaw<1> {
   static constexpr int state_dim = 1, obs_dim = 1, noise_dim = 1, control_dim = 0;
   static constexpr bool discrete_time = false;
+  static constexpr bool time_invariant = true;  // f, G, h, R: no function of t
   static constexpr const char* name = "cubic-sensor";
   static constexpr const char* description = "cubic sensor: dx = sigma dw, dy = x^3 dt + r dv";
   using Control = Vec<control_dim>;

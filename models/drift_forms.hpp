@@ -92,6 +92,15 @@ struct DriftAndJacobian {
   Mat<N, N> jacobian;
 };
 
+/// f(x), its Jacobian and the Hessian of each component f_i at one point, from a model that computes them together
+/// (drift_derivatives: the second-order filters' drift).
+template <int N>
+struct DriftDerivatives {
+  Vec<N> drift;
+  Mat<N, N> jacobian;
+  Mat<N, N> hessian[N];
+};
+
 /// Gaussian expectations of the drift under x ~ N(m, P): mean = E[f(x)], jacobian = E[grad f(x)], which by
 /// Stein's lemma equals Sunahara's E[(f - a)(x - m)^T] P^{-1} (seed 000 (5.12b)) and needs no P^{-1}.
 template <int N>

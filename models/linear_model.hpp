@@ -15,6 +15,7 @@ template <int N>
 struct LinearModel : InitialLaw<N> {
   static constexpr int state_dim = N, obs_dim = N, noise_dim = N, control_dim = 1;
   static constexpr bool discrete_time = false;
+  static constexpr bool time_invariant = true;  // f, G, h, R: no function of t
   static constexpr const char* name = "linear";
   static constexpr const char* description = "linear: dx = (a0 + A x) dt + b dw, dy = (c0 + C x) dt + R dv (dim 1..3)";
   using Control = Vec<control_dim>;

@@ -52,6 +52,14 @@ struct has_drift_and_jacobian<
     : std::true_type {};
 
 template <class Model, class = void>
+struct has_drift_derivatives : std::false_type {};
+template <class Model>
+struct has_drift_derivatives<
+    Model, std::void_t<decltype(std::declval<const Model&>().drift_derivatives(
+               0.0, std::declval<const Vec<Model::state_dim>&>(), std::declval<const typename Model::Control&>()))>>
+    : std::true_type {};
+
+template <class Model, class = void>
 struct has_gaussian_observation : std::false_type {};
 template <class Model>
 struct has_gaussian_observation<Model, std::void_t<decltype(std::declval<const Model&>().gaussian_observation(
@@ -78,6 +86,11 @@ template <class Model>
 struct has_model_facts<Model, std::void_t<decltype(std::declval<const Model&>().model_facts())>> : std::true_type {};
 
 template <class Model, class = void>
+struct declares_time_invariant : std::false_type {};
+template <class Model>
+struct declares_time_invariant<Model, std::enable_if_t<Model::time_invariant>> : std::true_type {};
+
+template <class Model, class = void>
 struct declares_non_integrable_drift : std::false_type {};
 template <class Model>
 struct declares_non_integrable_drift<Model, std::enable_if_t<!Model::drift_gaussian_integrable>> : std::true_type {};
@@ -97,6 +110,9 @@ struct ModelTraits {
   static constexpr bool quadratic_polynomial = linear || detail::has_quadratic_polynomial<Model>::value;
   static constexpr bool polynomial = power_polynomial || quadratic_polynomial;
   static constexpr bool sdc = linear || detail::has_sdc_drift<Model>::value;
+  /// f, G, h and R do not depend on t (the model states `time_invariant = true`; test_model_forms checks it): a
+  /// filter may evaluate what depends on them alone once (KBL's linearization at the origin).
+  static constexpr bool time_invariant = detail::declares_time_invariant<Model>::value;
   /// dx = (f(t, x) + B(t) u) dt: the model has a control input, B = control_input(t) (`kushner control`).
   static constexpr bool controlled = Model::control_dim > 0;
   /// h(t, x) = C(t, x) x + c0(t): linear, or the model's sdc_observation (seed 001 (5)).

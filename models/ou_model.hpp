@@ -11,6 +11,7 @@ namespace kushner {
 struct OuModel : InitialLaw<1> {
   static constexpr int state_dim = 1, obs_dim = 1, noise_dim = 1, control_dim = 0;
   static constexpr bool discrete_time = false;
+  static constexpr bool time_invariant = true;  // f, G, h, R: no function of t
   static constexpr const char* name = "ou";
   static constexpr const char* description =
       "scalar Ornstein-Uhlenbeck: dx = -theta (x - mu) dt + sigma dw, dy = x dt + r dv";

@@ -17,6 +17,7 @@ namespace kushner {
 struct PendulumModel : InitialLaw<2> {
   static constexpr int state_dim = 2, obs_dim = 1, noise_dim = 1, control_dim = 0;
   static constexpr bool discrete_time = false;
+  static constexpr bool time_invariant = true;  // f, G, h, R: no function of t
   static constexpr const char* name = "pendulum";
   static constexpr const char* description =
       "pendulum: dx1 = x2 dt, dx2 = -g sin(x1) dt + q dw, dy = sin(x1) dt + r dv";

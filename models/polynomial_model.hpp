@@ -114,6 +114,7 @@ struct PolynomialModel : InitialLaw<N> {
   static_assert(N >= 1 && N <= 3, "PolynomialModel: state dimension 1, 2 or 3");
   static constexpr int state_dim = N, obs_dim = N, noise_dim = N, control_dim = 1;
   static constexpr bool discrete_time = false;
+  static constexpr bool time_invariant = true;  // f, G, h, R: no function of t
   static constexpr bool linear_observation = true;
   static constexpr const char* name = "polynomial";
   static constexpr const char* description =

@@ -15,6 +15,7 @@ namespace kushner {
 struct RangeBearingModel : InitialLaw<2> {
   static constexpr int state_dim = 2, obs_dim = 2, noise_dim = 2, control_dim = 0;
   static constexpr bool discrete_time = false;
+  static constexpr bool time_invariant = true;  // f, G, h, R: no function of t
   static constexpr const char* name = "range-bearing";
   static constexpr const char* description =
       "planar target, range and bearing sensor: dx = -theta x dt + q dw, dy = (|x - s|, atan2(x - s)) dt + R dv";

@@ -13,6 +13,7 @@ namespace kushner {
 struct SineModel : InitialLaw<1> {
   static constexpr int state_dim = 1, obs_dim = 1, noise_dim = 1, control_dim = 1;
   static constexpr bool discrete_time = false;
+  static constexpr bool time_invariant = true;  // f, G, h, R: no function of t
   static constexpr bool linear_observation = true;
   static constexpr const char* name = "sine";
   static constexpr const char* description = "Sunahara 1968 Example 1: dx = -sin(x) dt + q dw, dy = x dt + r dv";
@@ -40,17 +41,20 @@ struct SineModel : InitialLaw<1> {
   KOKKOS_INLINE_FUNCTION Mat<1, 1> drift_jacobian(double, const Vec<1>& x, const Control&) const {
     return {{{-math::cos_apart_from_sin(x[0])}}};
   }
-  /// drift and drift_jacobian, the same bits, with one range reduction for the sine and cosine on a GPU.
-  KOKKOS_INLINE_FUNCTION DriftAndJacobian<1> drift_and_jacobian(double, const Vec<1>& x, const Control& u) const {
+  /// drift, drift_jacobian and drift_hessian, the same bits, from one sine and cosine: on a GPU one range reduction
+  /// for all three (math::sin_cos). nvcc did not merge the SOF's two calls of sin_cos at one mean, one for its
+  /// linearization and one for its Hessian, when each took a call of its own (perf/filter_bank.md).
+  KOKKOS_INLINE_FUNCTION DriftDerivatives<1> drift_derivatives(double, const Vec<1>& x, const Control& u) const {
     double s, c;
     math::sin_cos(x[0], s, c);
-    return {{{-s + B(0, 0) * u[0]}}, {{{-c}}}};
+    return {{{-s + B(0, 0) * u[0]}}, {{{-c}}}, {{{{s}}}}};
   }
-  /// Its sine by sin_cos: the SOF asks for it where it asked drift_and_jacobian, and nvcc computes the same call once.
-  KOKKOS_INLINE_FUNCTION Mat<1, 1> drift_hessian(double, const Vec<1>& x, const Control&, int) const {
-    double s, c;
-    math::sin_cos(x[0], s, c);
-    return {{{s}}};
+  KOKKOS_INLINE_FUNCTION DriftAndJacobian<1> drift_and_jacobian(double t, const Vec<1>& x, const Control& u) const {
+    const DriftDerivatives<1> d = drift_derivatives(t, x, u);
+    return {d.drift, d.jacobian};
+  }
+  KOKKOS_INLINE_FUNCTION Mat<1, 1> drift_hessian(double t, const Vec<1>& x, const Control& u, int) const {
+    return drift_derivatives(t, x, u).hessian[0];
   }
   template <class T>
   KOKKOS_INLINE_FUNCTION Mat<1, 1, T> diffusion(double, const Vec<1, T>&) const {

@@ -5,12 +5,16 @@
 // float dynamics of a model that has them (fp32's particle step) against its double ones. Every continuous-time
 // model of the registry is checked for every form it has.
 #include "kernels/filters/gaussian_expectations.hpp"
+#include "kernels/filters/linearized_kalman_bucy_filter.hpp"
 #include "kernels/particle_filter/particle_model_traits.hpp"
 #include "models/registry.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <string>
 
 namespace kushner {
 namespace {
@@ -56,6 +60,18 @@ void expect_forms_match_drift(const Model& model) {
         EXPECT_EQ(together.drift[i], drift[i]) << name << " drift_and_jacobian's drift [" << i << "]";
         for (int j = 0; j < n; ++j)
           EXPECT_EQ(together.jacobian(i, j), J(i, j)) << name << " drift_and_jacobian's (" << i << ", " << j << ")";
+      }
+      if constexpr (detail::has_drift_derivatives<Model>::value) {
+        const DriftDerivatives<n> all = model.drift_derivatives(t, x, control);
+        for (int i = 0; i < n; ++i) {
+          EXPECT_EQ(all.drift[i], drift[i]) << name << " drift_derivatives' drift [" << i << "]";
+          const Mat<n, n> H = model.drift_hessian(t, x, control, i);
+          for (int j = 0; j < n; ++j) {
+            EXPECT_EQ(all.jacobian(i, j), J(i, j)) << name << " drift_derivatives' (" << i << ", " << j << ")";
+            for (int l = 0; l < n; ++l)
+              EXPECT_EQ(all.hessian[i](j, l), H(j, l)) << name << " drift_derivatives' Hessian " << i;
+          }
+        }
       }
     }
     if constexpr (T::power_polynomial)
@@ -139,8 +155,70 @@ TEST(ModelForms, EveryFormAModelHasDescribesItsDrift) {
   EXPECT_EQ(with_float_dynamics, 5);  // ou, sine, linear 1-3
 }
 
-/// Counts the points where the sine model's drift_and_jacobian differs from its drift and drift_jacobian: arguments
-/// up to 100, and every 7th up to 1e6 (the slow range reduction past ~2^20 too), of both signs.
+/// The same bit patterns (a NaN too: range-bearing's dh/dx at the origin).
+std::uint64_t bits_of(double v) {
+  std::uint64_t b;
+  std::memcpy(&b, &v, sizeof b);
+  return b;
+}
+template <int R, int C>
+void expect_same_bits(const Mat<R, C>& a, const Mat<R, C>& b, const std::string& what) {
+  for (int i = 0; i < R; ++i)
+    for (int j = 0; j < C; ++j)
+      EXPECT_EQ(bits_of(a(i, j)), bits_of(b(i, j))) << what << " (" << i << ", " << j << "): " << a(i, j);
+}
+template <int N>
+void expect_same_bits(const Vec<N>& a, const Vec<N>& b, const std::string& what) {
+  for (int i = 0; i < N; ++i) EXPECT_EQ(bits_of(a[i]), bits_of(b[i])) << what << " [" << i << "]: " << a[i];
+}
+
+/// A model that states it is time invariant: f, df/dx, G, h, dh/dx and R the same at every t, at the origin (where
+/// KBL and MIXED evaluate them, once) and elsewhere; and KBL's linearization at the origin, taken once, what its
+/// evaluation at each step gives.
+template <class Model>
+void expect_time_invariant(const Model& model) {
+  constexpr int n = Model::state_dim;
+  const std::string name = Model::name;
+  const auto u = Model::Control::zero();
+  for (int k = -1; k < 3; ++k) {
+    const Vec<n> x = k < 0 ? Vec<n>::zero() : test_point<Model>(k);
+    for (const double t : {0.4, 3.7, 120.0}) {
+      const std::string at = name + " at t = " + std::to_string(t) + ", point " + std::to_string(k);
+      const DriftAndJacobian<n> f0 = drift_and_jacobian(model, 0.0, x, u), f = drift_and_jacobian(model, t, x, u);
+      expect_same_bits(f.drift, f0.drift, at + " f");
+      expect_same_bits(f.jacobian, f0.jacobian, at + " df/dx");
+      expect_same_bits(model.diffusion(t, x), model.diffusion(0.0, x), at + " G");
+      expect_same_bits(model.observation(t, x), model.observation(0.0, x), at + " h");
+      expect_same_bits(model.observation_jacobian(t, x), model.observation_jacobian(0.0, x), at + " dh/dx");
+      expect_same_bits(model.observation_noise(t), model.observation_noise(0.0), at + " R");
+    }
+  }
+  const auto once = OriginLinearization<Model, true>::of(model);
+  const OriginLinearization<Model, false> each_step;
+  for (const double t : {0.0, 0.4, 3.7}) {
+    expect_same_bits(once.drift(model, t).a, each_step.drift(model, t).a, name + " a0");
+    expect_same_bits(once.drift(model, t).J, each_step.drift(model, t).J, name + " F0");
+    expect_same_bits(once.drift(model, t).W, each_step.drift(model, t).W, name + " W0");
+    expect_same_bits(once.observation(model, t).h, each_step.observation(model, t).h, name + " c0");
+    expect_same_bits(once.observation(model, t).H, each_step.observation(model, t).H, name + " H0");
+  }
+}
+
+TEST(ModelForms, ATimeInvariantModelIsTheSameAtEveryTime) {
+  int checked = 0;
+  detail::for_each_model_type([&](auto* tag) {
+    using Model = std::remove_pointer_t<decltype(tag)>;
+    if constexpr (!Model::discrete_time && ModelTraits<Model>::time_invariant) {
+      expect_time_invariant(Model{});
+      ++checked;
+    }
+  });
+  EXPECT_EQ(checked, 10);  // ou, sine, cubic-oscillator, linear 1-3, benes, cubic-sensor, pendulum, range-bearing
+}
+
+/// Counts the points where the sine model's drift_and_jacobian differs from its drift and drift_jacobian, and its
+/// drift_derivatives' Hessian from the sine of its drift: arguments up to 100, and every 7th up to 1e6 (the slow range
+/// reduction past ~2^20 too), of both signs.
 struct SineDriftAndJacobianMismatches {
   SineModel sine;
   int points;
@@ -151,6 +229,8 @@ struct SineDriftAndJacobianMismatches {
     const DriftAndJacobian<1> together = sine.drift_and_jacobian(0.0, x, u);
     count += together.drift[0] == sine.drift(0.0, x, u)[0] ? 0 : 1;
     count += together.jacobian(0, 0) == sine.drift_jacobian(0.0, x, u)(0, 0) ? 0 : 1;
+    // The Hessian sin(x) (drift_derivatives') against -drift with no control, math::sin's.
+    count += sine.drift_derivatives(0.0, x, u).hessian[0](0, 0) == -sine.drift(0.0, x, u)[0] ? 0 : 1;
   }
 };
 
@@ -161,7 +241,7 @@ TEST(ModelForms, SineDriftAndJacobianAreItsDriftAndJacobianWhereKernelsRun) {
   int differ = 0;
   Kokkos::parallel_reduce("test::sine_drift_and_jacobian", Kokkos::RangePolicy<Space>(0, points),
                           SineDriftAndJacobianMismatches{SineModel{}, points}, differ);
-  EXPECT_EQ(differ, 0) << "of " << 2 * points << " values, on " << Space::name();
+  EXPECT_EQ(differ, 0) << "of " << 3 * points << " values, on " << Space::name();
 }
 
 TEST(ModelForms, ClosedFormExpectationsDifferFromThePointValues) {  // power: E_N[f] != f(m) for nonlinear f

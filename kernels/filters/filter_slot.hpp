@@ -242,11 +242,14 @@ KOKKOS_INLINE_FUNCTION std::int64_t advance_lane(const Filter& filter, const Mod
     double& mi = m_column[member + i * m_stride];
     mi = good ? m[i] : mi;
   }
-  for (int i = 0; i < n; ++i)
-    for (int j = i; j < n; ++j) {
+  for (int i = 0; i < n; ++i) {  // store_symmetric's values
+    double& Pii = P_column[member + packed_index(n, i, i) * P_stride];
+    Pii = good ? P(i, i) : Pii;
+    for (int j = i + 1; j < n; ++j) {
       double& Pij = P_column[member + packed_index(n, i, j) * P_stride];
-      Pij = good ? 0.5 * (P(i, j) + P(j, i)) : Pij;  // store_symmetric's value
+      Pij = good ? 0.5 * (P(i, j) + P(j, i)) : Pij;
     }
+  }
   const Vec<n> e = m - xm;
   const double squared_error = dot(e, e);
   const bool has_nees = good && definiteness == Definiteness::positive_definite;

@@ -8,19 +8,49 @@
 
 namespace kushner {
 
-/// The linearization at the origin, evaluated at m: (a0 + F0 m, F0, W0) and (c0 + H0 m, H0).
+/// The linearizations at the origin, (a0, F0, W0) and (c0, H0): at each step's t, or, where the model does not depend
+/// on t (ModelTraits::time_invariant), once when the filter is created. Every member computed the same values at every
+/// step: on a GPU the sine model's sine and cosine polynomials at 0, ~45 instructions of the sine bank's ~1520 per
+/// member-step (perf/filter_bank.md).
+template <class Model, bool = ModelTraits<Model>::time_invariant>
+struct OriginLinearization {
+  static constexpr int n = Model::state_dim, p = Model::obs_dim;
+  static OriginLinearization of(const Model&) { return {}; }
+  KOKKOS_INLINE_FUNCTION DriftLinearization<n> drift(const Model& model, double t) const {
+    return drift_linearization(model, t, Vec<n>::zero());
+  }
+  KOKKOS_INLINE_FUNCTION ObservationLinearization<n, p> observation(const Model& model, double t) const {
+    return observation_linearization(model, t, Vec<n>::zero());
+  }
+};
 template <class Model>
+struct OriginLinearization<Model, true> {
+  static constexpr int n = Model::state_dim, p = Model::obs_dim;
+  DriftLinearization<n> drift_at_origin;
+  ObservationLinearization<n, p> observation_at_origin;
+  static OriginLinearization of(const Model& model) {
+    return {drift_linearization(model, 0.0, Vec<n>::zero()), observation_linearization(model, 0.0, Vec<n>::zero())};
+  }
+  KOKKOS_INLINE_FUNCTION DriftLinearization<n> drift(const Model&, double) const { return drift_at_origin; }
+  KOKKOS_INLINE_FUNCTION ObservationLinearization<n, p> observation(const Model&, double) const {
+    return observation_at_origin;
+  }
+};
+
+/// The linearizations at the origin evaluated at m: (a0 + F0 m, F0, W0) and (c0 + H0 m, H0).
+template <class Model, bool TimeInvariant>
 KOKKOS_INLINE_FUNCTION DriftLinearization<Model::state_dim> drift_linearization_at_origin(
-    const Model& model, double t, const Vec<Model::state_dim>& m) {
-  DriftLinearization<Model::state_dim> d = drift_linearization(model, t, Vec<Model::state_dim>::zero());
+    const OriginLinearization<Model, TimeInvariant>& origin, const Model& model, double t,
+    const Vec<Model::state_dim>& m) {
+  DriftLinearization<Model::state_dim> d = origin.drift(model, t);
   d.a += d.J * m;
   return d;
 }
-template <class Model>
+template <class Model, bool TimeInvariant>
 KOKKOS_INLINE_FUNCTION ObservationLinearization<Model::state_dim, Model::obs_dim> observation_linearization_at_origin(
-    const Model& model, double t, const Vec<Model::state_dim>& m) {
-  ObservationLinearization<Model::state_dim, Model::obs_dim> o =
-      observation_linearization(model, t, Vec<Model::state_dim>::zero());
+    const OriginLinearization<Model, TimeInvariant>& origin, const Model& model, double t,
+    const Vec<Model::state_dim>& m) {
+  ObservationLinearization<Model::state_dim, Model::obs_dim> o = origin.observation(model, t);
   o.h += o.H * m;
   return o;
 }
@@ -32,13 +62,17 @@ struct LinearizedKalmanBucyFilter {
   static constexpr const char* description = "Kalman-Bucy on the model linearized at the origin";
   static constexpr const char* unsupported = nullptr;
 
-  static LinearizedKalmanBucyFilter create(const OptionValues&, const Model&, long) { return {}; }
+  OriginLinearization<Model> origin;
+
+  static LinearizedKalmanBucyFilter create(const OptionValues&, const Model& model, long) {
+    return {OriginLinearization<Model>::of(model)};
+  }
 
   KOKKOS_INLINE_FUNCTION Status step(const Model& model, int, const StepInput<p>& in, Vec<n>& m, Mat<n, n>& P) const {
     Vec<p> weighted_innovation;
-    if (!kalman_update(observation_linearization_at_origin(model, in.t, m), in, m, P, weighted_innovation))
+    if (!kalman_update(observation_linearization_at_origin(origin, model, in.t, m), in, m, P, weighted_innovation))
       return Status::not_positive_definite;
-    euler_predict(drift_linearization_at_origin(model, in.t, m), in.dt, m, P);
+    euler_predict(drift_linearization_at_origin(origin, model, in.t, m), in.dt, m, P);
     return Status::ok;
   }
 };

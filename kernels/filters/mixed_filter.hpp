@@ -31,14 +31,18 @@ struct MixedFilter {
 
   static const char* unsupported_by(const ModelFacts& f) { return observation_unsupported_by(f); }
 
-  static MixedFilter create(const OptionValues&, const Model&, long) { return {}; }
+  OriginLinearization<Model> origin;  // KBL's
+
+  static MixedFilter create(const OptionValues&, const Model& model, long) {
+    return {OriginLinearization<Model>::of(model)};
+  }
 
   KOKKOS_INLINE_FUNCTION Status step(const Model& model, int, const StepInput<p>& in, Vec<n>& m, Mat<n, n>& P) const {
     static_assert(unsupported == nullptr, "MixedFilter: Model must have a polynomial drift and a linear observation");
     Vec<p> weighted_innovation;
-    if (!kalman_update(observation_linearization_at_origin(model, in.t, m), in, m, P, weighted_innovation))
+    if (!kalman_update(observation_linearization_at_origin(origin, model, in.t, m), in, m, P, weighted_innovation))
       return Status::not_positive_definite;
-    DriftLinearization<n> drift = drift_linearization_at_origin(model, in.t, m);
+    DriftLinearization<n> drift = drift_linearization_at_origin(origin, model, in.t, m);
     drift.a = polynomial_mean(model, in.t, m, P);
     euler_predict(drift, in.dt, m, P);
     return Status::ok;

@@ -5,7 +5,6 @@
 //   dP = (F P + P F^T + W - P H^T V^{-1} H P) dt + sum_l P Hess h_l P [V^{-1}(dy - h_bar dt)]_l.
 // SOF-B: Schwartz-Bass, row [12]: the same mean, the covariance without the dy term.
 #include "kernels/filters/filter_protocol.hpp"
-#include "kernels/filters/jacobian_linearization.hpp"
 #include "kernels/filters/second_order_terms.hpp"
 
 namespace kushner {
@@ -22,9 +21,7 @@ struct SecondOrderStep {
     Vec<p> w;
     if (!kalman_update(obs, in, m, P, w)) return Status::not_positive_definite;
     if constexpr (WithCurvatureTerm) P = symmetrize(P + observation_curvature_term(model, in.t, m0, P0, w));
-    DriftLinearization<n> drift = drift_linearization(model, in.t, m);
-    drift.a += drift_curvature(model, in.t, m, P);
-    euler_predict(drift, in.dt, m, P);
+    euler_predict(hessian_corrected_drift_linearization(model, in.t, m, P), in.dt, m, P);
     return Status::ok;
   }
 };

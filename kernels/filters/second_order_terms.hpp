@@ -1,6 +1,7 @@
 #pragma once
 // The Hessian terms of the second-order filters (seed 000 (6.8)-(6.9), Tables 1-2 rows [9], [12], [13]).
 #include "kernels/filters/filter_step.hpp"
+#include "kernels/filters/jacobian_linearization.hpp"
 
 namespace kushner {
 
@@ -13,15 +14,23 @@ KOKKOS_INLINE_FUNCTION double frobenius(const Mat<N, N>& A, const Mat<N, N>& B) 
   return s;
 }
 
-/// 1/2 tr(Hess f_i(m) P) for each i: what seed 000 (6.9) adds to f_i(m) (the caller has f(m) from its linearization).
+/// f_i(m) + 1/2 tr(Hess f_i(m) P) (seed 000 (6.9)), df/dx(m) and W at m: the second-order filters' drift
+/// linearization. f, df/dx and the Hessians from one evaluation where the model has drift_derivatives (the sine
+/// model: one sincos for the three), else from drift_and_jacobian and drift_hessian.
 template <class Model>
-KOKKOS_INLINE_FUNCTION Vec<Model::state_dim> drift_curvature(const Model& model, double t,
-                                                             const Vec<Model::state_dim>& m,
-                                                             const Mat<Model::state_dim, Model::state_dim>& P) {
+KOKKOS_INLINE_FUNCTION DriftLinearization<Model::state_dim> hessian_corrected_drift_linearization(
+    const Model& model, double t, const Vec<Model::state_dim>& m, const Mat<Model::state_dim, Model::state_dim>& P) {
   const auto u = Model::Control::zero();
-  Vec<Model::state_dim> c;
-  for (int i = 0; i < Model::state_dim; ++i) c[i] = 0.5 * frobenius(model.drift_hessian(t, m, u, i), P);
-  return c;
+  DriftAndJacobian<Model::state_dim> f;
+  if constexpr (detail::has_drift_derivatives<Model>::value) {
+    const DriftDerivatives<Model::state_dim> d = model.drift_derivatives(t, m, u);
+    f = {d.drift, d.jacobian};
+    for (int i = 0; i < Model::state_dim; ++i) f.drift[i] += 0.5 * frobenius(d.hessian[i], P);
+  } else {
+    f = drift_and_jacobian(model, t, m, u);
+    for (int i = 0; i < Model::state_dim; ++i) f.drift[i] += 0.5 * frobenius(model.drift_hessian(t, m, u, i), P);
+  }
+  return drift_linearization_of(model, t, m, f);
 }
 
 /// h_l(m) + 1/2 tr(Hess h_l(m) P): the predicted observation of rows [9], [12] (the "- 1/2 p h''" of n(x)).
