@@ -71,13 +71,12 @@ KOKKOS_INLINE_FUNCTION Mat<N, N> load_symmetric(const View& packed, int member) 
   return m;
 }
 
-/// Stores the symmetric part of m, (m + m^T) / 2, its diagonal as it is (symmetrize's).
+/// Stores the symmetric part of m (symmetrize's).
 template <int N, class View>
 KOKKOS_INLINE_FUNCTION void store_symmetric(const View& packed, int member, const Mat<N, N>& m) {
-  for (int i = 0; i < N; ++i) {
-    packed(member, packed_index(N, i, i)) = m(i, i);
-    for (int j = i + 1; j < N; ++j) packed(member, packed_index(N, i, j)) = 0.5 * (m(i, j) + m(j, i));
-  }
+  const Mat<N, N> s = symmetrize(m);
+  for (int i = 0; i < N; ++i)
+    for (int j = i; j < N; ++j) packed(member, packed_index(N, i, j)) = s(i, j);
 }
 
 template <int N, class View>

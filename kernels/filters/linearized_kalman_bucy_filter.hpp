@@ -28,8 +28,9 @@ struct OriginLinearization<Model, true> {
   static constexpr int n = Model::state_dim, p = Model::obs_dim;
   DriftLinearization<n> drift_at_origin;
   ObservationLinearization<n, p> observation_at_origin;
-  static OriginLinearization of(const Model& model) {
-    return {drift_linearization(model, 0.0, Vec<n>::zero()), observation_linearization(model, 0.0, Vec<n>::zero())};
+  static OriginLinearization of(const Model& model) {  // the time-varying form's, at t = 0
+    const OriginLinearization<Model, false> at_each_step;
+    return {at_each_step.drift(model, 0.0), at_each_step.observation(model, 0.0)};
   }
   KOKKOS_INLINE_FUNCTION DriftLinearization<n> drift(const Model&, double) const { return drift_at_origin; }
   KOKKOS_INLINE_FUNCTION ObservationLinearization<n, p> observation(const Model&, double) const {
