@@ -16,15 +16,17 @@ enum class Definiteness { positive_definite, singular, indefinite };
 template <int N>
 KOKKOS_INLINE_FUNCTION Definiteness semidefinite_cholesky(const Mat<N, N>& A, Mat<N, N>& L, double tolerance) {
   if constexpr (N == 1) {
-    // The loops below for N = 1, written out: GCC does not unroll a one-trip loop with several exits before it
-    // vectorizes, and a loop over members in SIMD lanes (kernels/filters/filter_slot.hpp) then fails.
+    // The loops below for N = 1, written out without branches: GCC does not unroll a one-trip loop with several
+    // exits before it vectorizes (a loop over members in SIMD lanes, kernels/filters/filter_slot.hpp, then fails),
+    // and on a GPU each exit was a branch with its convergence barrier. With tolerance >= 0 the loops' zero,
+    // tolerance * max(a, 0), is 0 for a <= 0 (so a < -zero is a < 0) and tolerance * a for a > 0: the same
+    // decisions for every a.
     const double a = A(0, 0);
-    const double zero = tolerance * (a > 0.0 ? a : 0.0);
-    L(0, 0) = 0.0;
-    if (!math::is_finite(a) || a < -zero) return Definiteness::indefinite;
-    if (a <= zero) return Definiteness::singular;
-    L(0, 0) = math::sqrt(a);
-    return Definiteness::positive_definite;
+    const bool indefinite = !math::is_finite(a) || a < 0.0;
+    const bool singular = !indefinite && a <= tolerance * a;
+    const bool definite = !indefinite && !singular;
+    L(0, 0) = definite ? math::sqrt(a) : 0.0;
+    return definite ? Definiteness::positive_definite : indefinite ? Definiteness::indefinite : Definiteness::singular;
   }
   double scale = 0.0;
   for (int i = 0; i < N; ++i) scale = A(i, i) > scale ? A(i, i) : scale;
@@ -87,10 +89,11 @@ struct PositiveDefiniteSolver {
   /// Whether S is positive definite (cholesky's test; a scalar: finite and > 0); the solves need it.
   KOKKOS_INLINE_FUNCTION bool factor(const Mat<P, P>& S) {
     if constexpr (P == 1) {
+      // The reciprocal whatever s is (not used where factor fails): a branch around it was a convergence barrier per
+      // filter and member-step on a GPU.
       const double s = S(0, 0);
-      if (!(math::is_finite(s) && s > 0.0)) return false;
       inverse = 1.0 / s;
-      return true;
+      return math::is_finite(s) && s > 0.0;
     } else {
       return cholesky(S, L);
     }

@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <type_traits>
 
 namespace kushner {
@@ -322,6 +323,32 @@ TEST(FilterSingleStep, KalmanBucyOnOrnsteinUhlenbeck) {
   const double m = s.m0 + u.K * u.innovation, P = s.P0 - dt * u.K * s.P0;
   expect_step(s, m - model.theta * (m - model.mu) * dt,
               (1 - model.theta * dt) * (1 - model.theta * dt) * P + model.sigma * model.sigma * dt, "KB");
+}
+
+/// A scalar covariance's definiteness (every filter's check after its step, written without branches for N = 1) as
+/// the general factorization's loops decide it: a pivot within tolerance * max(a, 0) of zero is zero, below minus that
+/// or not finite is indefinite; the factor sqrt(a) where definite, else 0.
+TEST(FilterSingleStep, AScalarCovarianceIsJudgedAsTheFactorizationLoopsJudgeIt) {
+  using limits = std::numeric_limits<double>;
+  const double inf = limits::infinity(), tiny = limits::denorm_min(), big = limits::max(), nan = limits::quiet_NaN();
+  const double values[] = {0.0, -0.0, tiny,  -tiny,  1e-300, -1e-300, 1e-10, 0.25,
+                           1.0, -1.0, 1e300, -1e300, big,    inf,     -inf,  nan};
+  int checked = 0;
+  for (const double tolerance : {0.0, covariance_tolerance, 0.5})
+    for (const double a : values) {
+      const double zero = tolerance * (a > 0.0 ? a : 0.0);
+      const Definiteness expected = !std::isfinite(a) || a < -zero ? Definiteness::indefinite
+                                    : a <= zero                    ? Definiteness::singular
+                                                                   : Definiteness::positive_definite;
+      Mat<1, 1> L;
+      EXPECT_EQ(semidefinite_cholesky(Mat<1, 1>{{{a}}}, L, tolerance), expected) << a << ", tolerance " << tolerance;
+      EXPECT_EQ(L(0, 0), expected == Definiteness::positive_definite ? std::sqrt(a) : 0.0) << a;
+      ++checked;
+    }
+  EXPECT_EQ(checked, 48);
+  EXPECT_TRUE(all_finite(Vec<3>{{1.0, -2.0, 1e308}}));
+  EXPECT_FALSE(all_finite(Vec<3>{{1.0, inf, 0.0}}));
+  EXPECT_FALSE(all_finite(Mat<2, 2>{{{1.0, 0.0}, {0.0, nan}}}));
 }
 
 TEST(FilterSingleStep, FiltersRefuseModelsTheyCannotHandle) {

@@ -98,7 +98,10 @@ KOKKOS_INLINE_FUNCTION void score_member(const Slot& s, int member, const Vec<N>
   const Vec<N> e = m - x;
   const double squared_error = dot(e, e);
   const bool has_nees = definiteness == Definiteness::positive_definite;
-  const double nees = has_nees ? inverse_quadratic_form(P, L, e) : math::quiet_nan();
+  // The form whatever P is (selected away where P is not positive definite): a branch around its division was a
+  // convergence barrier per filter and member-step on a GPU.
+  const double form = inverse_quadratic_form(P, L, e);
+  const double nees = has_nees ? form : math::quiet_nan();
   s.score(member, squared_error_sum) = sums.squared_error + squared_error;
   if (has_nees) {
     s.score(member, nees_sum) = sums.nees + nees;
@@ -173,12 +176,11 @@ KOKKOS_INLINE_FUNCTION void advance(const FilterSlot<Filter, MemSpace>& s, const
     if constexpr (detail::has_known_input<Filter, n>::value) s.filter.apply_known_input(member, control_shift);
   }
   if (status == Status::ok && !(all_finite(m) && all_finite(P))) status = Status::non_finite;
+  // Factored whatever the status (a failed step's factor is not used): a branch around it was a convergence barrier
+  // per filter and member-step on a GPU.
   Mat<n, n> L;
-  Definiteness definiteness = Definiteness::indefinite;
-  if (status == Status::ok) {
-    definiteness = semidefinite_cholesky(P, L, covariance_tolerance);
-    if (definiteness == Definiteness::indefinite) status = Status::not_positive_definite;
-  }
+  const Definiteness definiteness = semidefinite_cholesky(P, L, covariance_tolerance);
+  if (status == Status::ok && definiteness == Definiteness::indefinite) status = Status::not_positive_definite;
   if (speculative && old_status != Status::ok) {  // frozen: the step above is not taken
     if (record) mark_unscored(s, member);
     return;
