@@ -376,10 +376,15 @@ struct ColumnAddresses {
 };
 
 /// What block reductions count besides their moments: counted(s, m) says whether member m counts in counted column
-/// s, of counted.columns() (filters' divergences: NotOkMembers, kernels/filters/filter_metrics.hpp). Here: nothing.
+/// s, of counted.columns(), and on a GPU warp_count(j, s, begin, end) is a warp's count of a block (filters'
+/// divergences: NotOkMembers, kernels/filters/filter_metrics.hpp). Here: nothing.
 struct NothingCounted {
   KOKKOS_INLINE_FUNCTION int columns() const { return 0; }
   KOKKOS_INLINE_FUNCTION bool operator()(int, int) const { return false; }
+#if KUSHNER_CUDA_DEVICE_PASS
+  /// A warp's count of column s in [begin, end) (NotOkMembers::warp_count).
+  __device__ int warp_count(int, int, int, int) const { return 0; }
+#endif
 };
 
 /// The BlockStatistic of every (block, column) pair of `columns` (columns(c): column c's values, value(m)), and the
@@ -430,9 +435,7 @@ struct BlockColumnStatistics {
         const BlockStatistic s = warp_block_statistic(j, columns(c), begin, end);
         if (j == 0) store_block_statistic(blocks, num_columns, b, c, s);
       } else {
-        const int s = c - num_columns;
-        const int count = warp_block_count(
-            j, [&](const int m) { return counted(s, m); }, begin, end);
+        const int count = counted.warp_count(j, c - num_columns, begin, end);
         if (j == 0) blocks(b, 2 * num_columns + c) = count;
       }
       return;

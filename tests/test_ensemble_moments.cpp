@@ -191,6 +191,39 @@ TYPED_TEST(EnsembleMomentsTest, DivergenceCountsInTheMomentsLaunchEqualTheStatus
   }
 }
 
+/// NotOkMembers' count of eight members from two 64-bit words (a GPU warp's count of a whole block) against its
+/// member-by-member rule: every one of the 3^8 runs of eight statuses, each beside 16 runs of truths (8 of every
+/// one of the 256 ok / not-ok patterns, and 8 with non_finite and not_positive_definite mixed).
+TEST(DivergenceCounts, EightMembersFromTwoWordsAreCountedAsOneAtATime) {
+  constexpr int runs = 6561 * 16, members = 8 * runs;
+  Kokkos::View<Status*, Kokkos::LayoutLeft, Kokkos::HostSpace> truth("truth", members), status("status", members);
+  for (int r = 0; r < runs; ++r)
+    for (int k = 0; k < 8; ++k) {
+      int digits = r / 16;
+      for (int d = 0; d < k; ++d) digits /= 3;
+      status(8 * r + k) = static_cast<Status>(digits % 3);
+      const int pattern = (r * 37 + r / 16) % 256;
+      const bool mixed = r % 16 >= 8, not_ok = (pattern >> k) & 1;
+      truth(8 * r + k) = !not_ok ? Status::ok : mixed && k % 2 ? Status::not_positive_definite : Status::non_finite;
+    }
+  DivergedMembers<Kokkos::HostSpace> diverged;
+  const NotOkMembers<Kokkos::HostSpace> counted = diverged(Kokkos::DefaultHostExecutionSpace(), {status}, truth);
+  ASSERT_EQ(reinterpret_cast<std::uintptr_t>(status.data()) % 8, 0u);
+  ASSERT_EQ(reinterpret_cast<std::uintptr_t>(truth.data()) % 8, 0u);
+  int mismatches = 0, counted_somewhere = 0;
+  for (int r = 0; r < runs; ++r) {
+    int one_at_a_time = 0;
+    for (int m = 8 * r; m < 8 * r + 8; ++m) one_at_a_time += counted(0, m) ? 1 : 0;
+    mismatches += counted.count_eight(0, 8 * r) != one_at_a_time;
+    counted_somewhere += one_at_a_time > 0;
+  }
+  EXPECT_EQ(mismatches, 0);
+  EXPECT_GT(counted_somewhere, runs / 2);  // the runs are not all empty
+  for (const std::uint64_t byte : {0ull, 1ull, 2ull, 0x7full, 0x80ull, 0xffull})
+    for (int k = 0; k < 8; ++k)
+      EXPECT_EQ(NotOkMembers<Kokkos::HostSpace>::nonzero_bytes(byte << (8 * k)), byte == 0 ? 0 : 0x80ull << (8 * k));
+}
+
 /// Block rows (BlockStatistics' layout) of `outputs` outputs of `blocks` blocks, `columns` columns, `counted` counts:
 /// full, short and empty blocks, means around 1e3 (pooling must not lose their digits).
 std::vector<double> sample_block_rows(int outputs, int blocks, int columns, int counted) {

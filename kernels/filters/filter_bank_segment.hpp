@@ -271,8 +271,7 @@ struct FilterBankTeamSegment {
         if (j == 0) store_block_row(row, num_columns, c, s);
       } else {
         const int counted_column = c - num_columns;
-        const int count = warp_block_count(
-            j, [&](const int m) { return counted(counted_column, m); }, begin, end);
+        const int count = counted.warp_count(j, counted_column, begin, end);
         if (j == 0) row[3 * num_columns + counted_column] = count;
       }
     }

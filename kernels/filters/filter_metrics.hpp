@@ -89,6 +89,43 @@ struct NotOkMembers {
   KOKKOS_INLINE_FUNCTION bool operator()(const int s, const int m) const {
     return counts(truth_status(m), reinterpret_cast<const Status*>(statuses(s))[m]);
   }
+  /// The members first .. first + 7 that count in column s (first a multiple of 8): each byte column read as one
+  /// 64-bit word, its bytes tested at once (nonzero_bytes). On a GPU a warp counts a whole block so
+  /// (warp_count): a read and test of each byte, 13 instructions per member and column, were a sixth of what an
+  /// output step added to a segment of the sine bank (perf/filter_bank.md).
+  KOKKOS_INLINE_FUNCTION int count_eight(const int s, const int first) const {
+    static_assert(sizeof(Status) == 1 && static_cast<int>(Status::ok) == 0, "a status byte: ok is zero");
+    const std::uint64_t status = *reinterpret_cast<const std::uint64_t*>(statuses(s) + first);
+    const std::uint64_t truth = *reinterpret_cast<const std::uint64_t*>(truth_status.data() + first);
+    const std::uint64_t counted = nonzero_bytes(status) & ~nonzero_bytes(truth);
+#if KUSHNER_CUDA_DEVICE_PASS
+    return __popcll(counted);
+#else
+    return __builtin_popcountll(counted);
+#endif
+  }
+
+  /// The high bit of each byte of x that is not zero, the other bits clear: a byte's low seven bits plus 0x7f carry
+  /// into its high bit where any is set, and never out of the byte.
+  KOKKOS_INLINE_FUNCTION static std::uint64_t nonzero_bytes(const std::uint64_t x) {
+    constexpr std::uint64_t low7 = 0x7f7f7f7f7f7f7f7full;
+    return (((x & low7) + low7) | x) & ~low7;
+  }
+
+#if KUSHNER_CUDA_DEVICE_PASS
+  /// The members m in [begin, end) that count in column s, by the 32 lanes of a warp (lane j this thread), every
+  /// lane returning it: a whole block whose columns are 8-byte aligned by count_eight, lane j members begin + 8 j ..
+  /// begin + 8 j + 7 (an integer: any order gives the same count); else a member at a time (warp_block_count).
+  __device__ int warp_count(const int j, const int s, const int begin, const int end) const {
+    static_assert(moment_block_size == 8 * moment_lanes, "a lane counts eight members of a block");
+    const bool aligned = ((statuses(s) | reinterpret_cast<std::uintptr_t>(truth_status.data())) & 7u) == 0;
+    if (end - begin == moment_block_size && aligned)
+      return static_cast<int>(__reduce_add_sync(0xffffffffu, count_eight(s, begin + 8 * j)));
+    return warp_block_count(
+        j, [&](const int m) { return (*this)(s, m); }, begin, end);
+  }
+#endif
+
   /// The members m in [begin, end) that count in column s, on the host (FilterBankSegment): one plain loop over the
   /// two byte columns (operator() looks column s up for every member).
   int count(const int s, const int begin, const int end) const {
