@@ -175,7 +175,10 @@ KOKKOS_INLINE_FUNCTION void advance(const FilterSlot<Filter, MemSpace>& s, const
     m += control_shift;
     if constexpr (detail::has_known_input<Filter, n>::value) s.filter.apply_known_input(member, control_shift);
   }
-  if (status == Status::ok && !(all_finite(m) && all_finite(P))) status = Status::non_finite;
+  // Both tests taken (no && between them, whose branch was a convergence barrier per filter and member-step on a
+  // GPU; advance_lane keeps the && form: without it GCC did not vectorize the lanes' loop).
+  const bool finite = all_finite(m) & all_finite(P);
+  if (status == Status::ok && !finite) status = Status::non_finite;
   // Factored whatever the status (a failed step's factor is not used): a branch around it was a convergence barrier
   // per filter and member-step on a GPU.
   Mat<n, n> L;

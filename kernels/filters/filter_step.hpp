@@ -58,7 +58,8 @@ KOKKOS_INLINE_FUNCTION Mat<N, N> noise_intensity(const Mat<N, Q>& G) {
   return G * transpose(G);
 }
 
-/// Step 1: the update with dy. Returns false when S is not positive definite. `weighted_innovation`
+/// Step 1: the update with dy. Returns false when S is not positive definite (m and P are then no update's: a
+/// scalar S's is taken whatever S is, below). `weighted_innovation`
 /// receives S^{-1} (dy - h_hat dt), the V^{-1} (dy - h_hat dt) of the continuous equations, for filters
 /// whose covariance has dy terms.
 template <int N, int P>
@@ -67,13 +68,18 @@ KOKKOS_INLINE_FUNCTION bool kalman_update(const ObservationLinearization<N, P>& 
   const Mat<N, P> PHt = Pm * transpose(obs.H);
   const Mat<P, P> S = in.V + (obs.H * PHt) * in.dt;
   PositiveDefiniteSolver<P> solver;
-  if (!solver.factor(S)) return false;
+  const bool factored = solver.factor(S);
+  // A scalar S's update is taken whatever S is (where it fails, every caller's step fails, and the bank does not keep
+  // that step's m and P): a return here was a convergence barrier per filter and member-step on a GPU. A larger S's
+  // failed factor has no solves.
+  if constexpr (P > 1)
+    if (!factored) return false;
   const Vec<P> innovation = in.dy - obs.h * in.dt;
   weighted_innovation = solver.solve(innovation);
   const Mat<N, P> K = solver.right_solve(PHt);  // P H^T S^{-1}
   m += K * innovation;
   Pm = symmetrize(Pm - (K * transpose(PHt)) * in.dt);
-  return true;
+  return factored;
 }
 
 /// Step 2: the Euler prediction.
