@@ -192,8 +192,9 @@ TYPED_TEST(EnsembleMomentsTest, DivergenceCountsInTheMomentsLaunchEqualTheStatus
 }
 
 /// NotOkMembers' count of eight members from two 64-bit words (a GPU warp's count of a whole block) against its
-/// member-by-member rule: every one of the 3^8 runs of eight statuses, each beside 16 runs of truths (8 of every
-/// one of the 256 ok / not-ok patterns, and 8 with non_finite and not_positive_definite mixed).
+/// member-by-member rule: every one of the 3^8 runs of eight statuses, each beside 16 runs of truths with 16 different
+/// ok / not-ok patterns (every one of the 256 patterns beside ~410 runs of statuses), in 8 of them non_finite and
+/// not_positive_definite mixed.
 TEST(DivergenceCounts, EightMembersFromTwoWordsAreCountedAsOneAtATime) {
   constexpr int runs = 6561 * 16, members = 8 * runs;
   Kokkos::View<Status*, Kokkos::LayoutLeft, Kokkos::HostSpace> truth("truth", members), status("status", members);
