@@ -39,7 +39,7 @@ struct SineModel : InitialLaw<1> {
   }
   KOKKOS_INLINE_FUNCTION Mat<1, 1> control_input(double) const { return B; }
   KOKKOS_INLINE_FUNCTION Mat<1, 1> drift_jacobian(double, const Vec<1>& x, const Control&) const {
-    return {{{-math::cos_apart_from_sin(x[0])}}};
+    return {{{-math::cos(x[0])}}};
   }
   /// drift, drift_jacobian and drift_hessian, the same bits, from one sine and cosine: on a GPU one range reduction
   /// for all three (math::sin_cos). nvcc did not merge the SOF's two calls of sin_cos at one mean, one for its
