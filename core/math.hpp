@@ -13,10 +13,8 @@ namespace kushner::math {
 using impl::atan;
 using impl::atan2;
 using impl::cosh;
-using impl::exp;
 using impl::expm1;
 using impl::fabs;
-using impl::log;
 using impl::log1p;
 using impl::pow;
 using impl::sinh;
@@ -42,19 +40,20 @@ KOKKOS_INLINE_FUNCTION double quiet_nan() {
   return v;
 }
 
-/// sin and cos of a double on a host: one range reduction for both, written out so that a loop over members in SIMD
-/// lanes computes it inline (a libmvec call clobbers every vector register, and GCC has no vector sincos).
+/// sin, cos, exp and log of a double on a host, written out so that a loop over members in SIMD lanes computes them
+/// inline: a libmvec call clobbers every vector register (the lanes' values are spilled around it), and GCC has no
+/// vector sincos. Where there are no fused multiply-adds, libm's (and libmvec's).
 #if !KUSHNER_CUDA_DEVICE_PASS && (defined(__FMA__) || defined(__ARM_FEATURE_FMA))
-#define KUSHNER_HOST_SIN_COS 1
+#define KUSHNER_HOST_MATH 1
 #else
-#define KUSHNER_HOST_SIN_COS 0
+#define KUSHNER_HOST_MATH 0
 #endif
 
 struct SinCos {
   double sin, cos;
 };
 
-#if KUSHNER_HOST_SIN_COS
+#if KUSHNER_HOST_MATH
 /// Largest |x| that host_sin_cos reduces: q = x 2/pi stays below 2^44, where the shift below rounds it exactly and
 /// pi/2 in three doubles leaves r within 2^-54. An ulp of x is 2^-9 there; past it both results are NaN (a model's
 /// state that far out has diverged, and NaN marks it so).
@@ -95,10 +94,102 @@ __attribute__((always_inline)) inline SinCos host_sin_cos(const double x) {
   const bool reduced = std::fabs(x) < host_sin_cos_limit;
   return {reduced ? (sin_negative ? -s : s) : quiet_nan(), reduced ? (cos_negative ? -c : c) : quiet_nan()};
 }
+
+/// exp x = 2^k exp r with k = round(x / ln 2) (the same shift as host_sin_cos) and |r| <= ln2 / 2 (ln 2 in two
+/// doubles), exp r by its Taylor series to r^13 (truncated below 2^-57 relative), and 2^k applied as two powers of two,
+/// so that results in the subnormal range are rounded once. x is clamped to [-745.2, 709.8], past which exp is 0 and
+/// +inf. Within 1 ulp of long double's expl (test_math).
+__attribute__((always_inline)) inline double host_exp(const double x) {
+  constexpr double shift = 6755399441055744.0;  // 1.5 2^52
+  constexpr double ln2_hi = 0.6931471805599453, ln2_lo = 2.3190468138462996e-17;
+  const double clamped = x > 709.8 ? 709.8 : (x < -745.2 ? -745.2 : x);  // NaN stays NaN
+  const double shifted = std::fma(clamped, 1.4426950408889634, shift);
+  const double k = shifted - shift;
+  const double r = std::fma(-k, ln2_lo, std::fma(-k, ln2_hi, clamped));
+  double p = std::fma(1.0 / 6227020800.0, r, 1.0 / 479001600.0);  // 1 / 13!, 1 / 12!, ...
+  p = std::fma(p, r, 1.0 / 39916800.0);
+  p = std::fma(p, r, 1.0 / 3628800.0);
+  p = std::fma(p, r, 1.0 / 362880.0);
+  p = std::fma(p, r, 1.0 / 40320.0);
+  p = std::fma(p, r, 1.0 / 5040.0);
+  p = std::fma(p, r, 1.0 / 720.0);
+  p = std::fma(p, r, 1.0 / 120.0);
+  p = std::fma(p, r, 1.0 / 24.0);
+  p = std::fma(p, r, 1.0 / 6.0);
+  p = std::fma(p, r, 0.5);
+  p = std::fma(p, r, 1.0);
+  p = std::fma(p, r, 1.0);
+  std::int64_t k_bits, shift_bits;
+  std::memcpy(&k_bits, &shifted, sizeof k_bits);
+  std::memcpy(&shift_bits, &shift, sizeof shift_bits);
+  const std::int64_t k_int = k_bits - shift_bits, k1 = k_int >> 1, k2 = k_int - k1;  // each in [-538, 512]
+  const std::uint64_t scale1_bits = static_cast<std::uint64_t>(k1 + 1023) << 52,
+                      scale2_bits = static_cast<std::uint64_t>(k2 + 1023) << 52;
+  double scale1, scale2;
+  std::memcpy(&scale1, &scale1_bits, sizeof scale1);
+  std::memcpy(&scale2, &scale2_bits, sizeof scale2);
+  return p * scale1 * scale2;
+}
+
+/// log x = k ln 2 + log m with x = 2^k m, m in [sqrt(2)/2, sqrt(2)) (subnormal x scaled by 2^54 first), and log m by
+/// fdlibm's e_log.c (Sun Microsystems 1993): s = f / (2 + f) for f = m - 1, its minimax polynomial in s^2 and the
+/// same sums. log 0 = -inf, log of a negative x or NaN is NaN, log inf = inf. Within 1 ulp of long double's logl
+/// (test_math).
+__attribute__((always_inline)) inline double host_log(const double x) {
+  constexpr double ln2_hi = 6.93147180369123816490e-01, ln2_lo = 1.90821492927058770002e-10;  // k ln2_hi exact
+  // Every operation is taken for every x and the special values are put in by selects of bits: GCC does not vectorize
+  // a loop in which a select's arm would have to compute (a division or product may trap).
+  const bool subnormal = x < 0x1p-1022;
+  const double scaled = x * (subnormal ? 0x1p54 : 1.0);
+  std::int64_t bits;
+  std::memcpy(&bits, &scaled, sizeof bits);
+  const std::int64_t above_half_sqrt2 = bits - 0x3fe6a09e667f3bcdll;  // sqrt(2)/2's bits
+  const std::int64_t k = above_half_sqrt2 >> 52;                      // arithmetic shift: x's exponent from there
+  const std::int64_t m_bits = bits - (k << 52);
+  double m;
+  std::memcpy(&m, &m_bits, sizeof m);
+  const double f = m - 1.0, s = f / (2.0 + f), z = s * s, w = z * z;
+  const double t1 = w * (3.999999999940941908e-01 + w * (2.222219843214978396e-01 + w * 1.531383769920937332e-01));
+  const double t2 =
+      z * (6.666666666666735130e-01 +
+           w * (2.857142874366239149e-01 + w * (1.818357216161805012e-01 + w * 1.479819860511658591e-01)));
+  const double R = t2 + t1, half_f_squared = 0.5 * f * f;
+  const double dk = static_cast<double>(k - (subnormal ? 54 : 0));
+  const double log_x = dk * ln2_hi - ((half_f_squared - (s * (half_f_squared + R) + dk * ln2_lo)) - f);
+  const double inf = 0x1p1023 * 2.0;
+  const double special = x == 0.0 ? -inf : (x == inf ? inf : quiet_nan());
+  std::uint64_t log_bits, special_bits;
+  std::memcpy(&log_bits, &log_x, sizeof log_bits);
+  std::memcpy(&special_bits, &special, sizeof special_bits);
+  const std::uint64_t regular = (x > 0.0) & (x < inf) ? ~0ull : 0ull;
+  const std::uint64_t result_bits = (log_bits & regular) | (special_bits & ~regular);
+  double result;
+  std::memcpy(&result, &result_bits, sizeof result);
+  return result;
+}
 #endif
 
+KOKKOS_FORCEINLINE_FUNCTION double exp(double x) {
+#if KUSHNER_HOST_MATH
+  return host_exp(x);
+#else
+  return impl::exp(x);
+#endif
+}
+
+KOKKOS_FORCEINLINE_FUNCTION double log(double x) {
+#if KUSHNER_HOST_MATH
+  return host_log(x);
+#else
+  return impl::log(x);
+#endif
+}
+
+KOKKOS_INLINE_FUNCTION float exp(float x) { return impl::exp(x); }
+KOKKOS_INLINE_FUNCTION float log(float x) { return impl::log(x); }
+
 KOKKOS_FORCEINLINE_FUNCTION double sin(double x) {
-#if KUSHNER_HOST_SIN_COS
+#if KUSHNER_HOST_MATH
   return host_sin_cos(x).sin;
 #else
   return impl::sin(x);
@@ -106,7 +197,7 @@ KOKKOS_FORCEINLINE_FUNCTION double sin(double x) {
 }
 
 KOKKOS_FORCEINLINE_FUNCTION double cos(double x) {
-#if KUSHNER_HOST_SIN_COS
+#if KUSHNER_HOST_MATH
   return host_sin_cos(x).cos;
 #else
   return impl::cos(x);
@@ -141,7 +232,7 @@ KOKKOS_INLINE_FUNCTION constexpr double infinity() { return Kokkos::Experimental
 KOKKOS_FORCEINLINE_FUNCTION void sin_cos(double x, double& s, double& c) {
 #if KUSHNER_CUDA_DEVICE_PASS
   ::sincos(x, &s, &c);
-#elif KUSHNER_HOST_SIN_COS
+#elif KUSHNER_HOST_MATH
   const SinCos both = host_sin_cos(x);
   s = both.sin;
   c = both.cos;

@@ -4,8 +4,8 @@
 // (bits/math-vector.h), whose other effects (finite-math-only, reassociation) we do not want; GCC also
 // needs -fno-math-errno to call them (CMake sets both when KUSHNER_ENABLE_VECTOR_MATH is on).
 // It is most of the host particle step's speed (perf/particle_filter.md, CPU section). With fused multiply-adds the
-// host's sin and cos of a double are core/math.hpp's own (host_sin_cos, inline: no call in the loop); libmvec's sin and
-// cos serve builds without them. libmvec's results are within 4
+// host's sin, cos, exp and log of a double are core/math.hpp's own (inline: no call in the loop); libmvec's double
+// functions serve builds without them, and its float ones every build. libmvec's results are within 4
 // ulp of libm's, so the CPU numbers differ from a scalar build in the last bits; within one binary they are the same on
 // any number of threads, because every backend calls the same block function (particle_filter/particle_block_step.hpp)
 // or member chunk function (for_each_member.hpp, which includes this header so that every unit compiles it alike).
