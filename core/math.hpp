@@ -119,12 +119,12 @@ __attribute__((always_inline)) inline double host_exp(const double x) {
   p = std::fma(p, r, 0.5);
   p = std::fma(p, r, 1.0);
   p = std::fma(p, r, 1.0);
-  std::int64_t k_bits, shift_bits;
+  std::uint64_t k_bits, shift_bits;  // unsigned: a NaN's bits minus the shift's would overflow an int64
   std::memcpy(&k_bits, &shifted, sizeof k_bits);
   std::memcpy(&shift_bits, &shift, sizeof shift_bits);
-  const std::int64_t k_int = k_bits - shift_bits, k1 = k_int >> 1, k2 = k_int - k1;  // each in [-538, 512]
-  const std::uint64_t scale1_bits = static_cast<std::uint64_t>(k1 + 1023) << 52,
-                      scale2_bits = static_cast<std::uint64_t>(k2 + 1023) << 52;
+  const std::int64_t k_int = static_cast<std::int64_t>(k_bits - shift_bits), k1 = k_int >> 1, k2 = k_int - k1;
+  const std::uint64_t scale1_bits = static_cast<std::uint64_t>(k1 + 1023) << 52,  // k1, k2 in [-538, 512]
+      scale2_bits = static_cast<std::uint64_t>(k2 + 1023) << 52;
   double scale1, scale2;
   std::memcpy(&scale1, &scale1_bits, sizeof scale1);
   std::memcpy(&scale2, &scale2_bits, sizeof scale2);
@@ -141,11 +141,11 @@ __attribute__((always_inline)) inline double host_log(const double x) {
   // a loop in which a select's arm would have to compute (a division or product may trap).
   const bool subnormal = x < 0x1p-1022;
   const double scaled = x * (subnormal ? 0x1p54 : 1.0);
-  std::int64_t bits;
+  std::uint64_t bits;  // unsigned arithmetic: a negative x's bits would overflow an int64, and k << 52 is negative
   std::memcpy(&bits, &scaled, sizeof bits);
-  const std::int64_t above_half_sqrt2 = bits - 0x3fe6a09e667f3bcdll;  // sqrt(2)/2's bits
-  const std::int64_t k = above_half_sqrt2 >> 52;                      // arithmetic shift: x's exponent from there
-  const std::int64_t m_bits = bits - (k << 52);
+  const std::uint64_t above_half_sqrt2 = bits - 0x3fe6a09e667f3bcdull;       // sqrt(2)/2's bits
+  const std::int64_t k = static_cast<std::int64_t>(above_half_sqrt2) >> 52;  // x's exponent from there (arithmetic)
+  const std::uint64_t m_bits = bits - (static_cast<std::uint64_t>(k) << 52);
   double m;
   std::memcpy(&m, &m_bits, sizeof m);
   const double f = m - 1.0, s = f / (2.0 + f), z = s * s, w = z * z;
