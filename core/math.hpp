@@ -133,8 +133,8 @@ __attribute__((always_inline)) inline double host_exp(const double x) {
 
 /// log x = k ln 2 + log m with x = 2^k m, m in [sqrt(2)/2, sqrt(2)) (subnormal x scaled by 2^54 first), and log m by
 /// fdlibm's e_log.c (Sun Microsystems 1993): s = f / (2 + f) for f = m - 1, its minimax polynomial in s^2 and the
-/// same sums. log 0 = -inf, log of a negative x or NaN is NaN, log inf = inf. Within 1 ulp of long double's logl
-/// (test_math).
+/// same sums (not fused: the native build's -ffp-contract=off makes scalar and SIMD code round them alike). log 0 =
+/// -inf, log of a negative x or NaN is NaN, log inf = inf. Within 1 ulp of long double's logl (test_math).
 __attribute__((always_inline)) inline double host_log(const double x) {
   constexpr double ln2_hi = 6.93147180369123816490e-01, ln2_lo = 1.90821492927058770002e-10;  // k ln2_hi exact
   // Every operation is taken for every x and the special values are put in by selects of bits: GCC does not vectorize
