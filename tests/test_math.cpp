@@ -16,7 +16,7 @@ namespace {
 
 #if KUSHNER_HOST_MATH
 
-/// |a - b| in units of 2^-53 (an error of 1 is half an ulp of a value in [0.5, 1)).
+/// |a - b| in units of 2^-53 (an ulp of a value in [0.5, 1), half an ulp of one in [1, 2)).
 long double absolute_error(double a, long double b) { return std::fabs(static_cast<long double>(a) - b) * 0x1p53L; }
 
 /// |a - b| in ulps of b (a subnormal b's ulp is 2^-1074).
