@@ -24,21 +24,26 @@ using impl::tanh;
 
 constexpr double pi = 3.14159265358979323846;
 
-/// True unless v is NaN or +-Inf. Tests the exponent bits, so it stays correct under -ffinite-math-only
-/// (implied by -ffast-math), where std::isfinite folds to a constant.
-KOKKOS_INLINE_FUNCTION bool is_finite(double v) {
+/// A double's bit pattern, and the double of a bit pattern (std::bit_cast is C++20).
+KOKKOS_FORCEINLINE_FUNCTION std::uint64_t bits_of(double v) {
   std::uint64_t bits;
   std::memcpy(&bits, &v, sizeof bits);
-  return (bits & 0x7ff0000000000000ull) != 0x7ff0000000000000ull;
+  return bits;
 }
-
-/// A quiet NaN, built from its bit pattern: std::numeric_limits is not device-callable everywhere.
-KOKKOS_INLINE_FUNCTION double quiet_nan() {
-  const std::uint64_t bits = 0x7ff8000000000000ull;
+KOKKOS_FORCEINLINE_FUNCTION double from_bits(std::uint64_t bits) {
   double v;
   std::memcpy(&v, &bits, sizeof v);
   return v;
 }
+
+/// True unless v is NaN or +-Inf. Tests the exponent bits, so it stays correct under -ffinite-math-only
+/// (implied by -ffast-math), where std::isfinite folds to a constant.
+KOKKOS_INLINE_FUNCTION bool is_finite(double v) {
+  return (bits_of(v) & 0x7ff0000000000000ull) != 0x7ff0000000000000ull;
+}
+
+/// A quiet NaN, built from its bit pattern: std::numeric_limits is not device-callable everywhere.
+KOKKOS_INLINE_FUNCTION double quiet_nan() { return from_bits(0x7ff8000000000000ull); }
 
 /// sin, cos, exp and log of a double on a host, written out so that a loop over members in SIMD lanes computes them
 /// inline: a libmvec call clobbers every vector register (the lanes' values are spilled around it), and GCC has no
@@ -59,19 +64,29 @@ struct SinCos {
 /// state that far out has diverged, and NaN marks it so).
 constexpr double host_sin_cos_limit = 17592186044416.0;  // 2^44
 
-/// x = q pi/2 + r with |r| <= pi/4 (q rounded from the exact product by adding 1.5 2^52, whose last two bits are then
-/// q mod 4; r by fused multiply-adds with pi/2 = c1 + c2 + c3), then fdlibm's minimax polynomials for sin and cos on
+/// q = x c rounded to the nearest integer (ties to even) from the exact product, for |x c| < 2^51: adding 1.5 2^52
+/// leaves q in the sum's last bits, so `bits` is q in two's complement (its low bits q mod 4, q mod 2^k).
+struct NearestInteger {
+  double value;
+  std::uint64_t bits;
+};
+__attribute__((always_inline)) inline NearestInteger nearest_integer_of_product(const double x, const double c) {
+  constexpr double shift = 6755399441055744.0;  // 1.5 2^52
+  const double shifted = std::fma(x, c, shift);
+  return {shifted - shift, bits_of(shifted) - bits_of(shift)};
+}
+
+/// x = q pi/2 + r with |r| <= pi/4 (q by nearest_integer_of_product; r by fused multiply-adds with pi/2 = c1 + c2 +
+/// c3), then fdlibm's minimax polynomials for sin and cos on
 /// [-pi/4, pi/4] (k_sin.c, k_cos.c, Sun Microsystems 1993) and the quadrant's signs. Errors against long double's
 /// sinl and cosl (test_math): at most 1.1 2^-53 in absolute value below the limit (glibc's sin: 0.5), within an ulp of
 /// the result for |x| <= pi/4 and near the zeros of either. sin(-0) is +0. Every multiply-add is a std::fma, so
 /// scalar and SIMD code give the same bits. Always inlined: a call in a loop stops GCC from vectorizing it.
 __attribute__((always_inline)) inline SinCos host_sin_cos(const double x) {
-  constexpr double shift = 6755399441055744.0;  // 1.5 2^52
   constexpr double c1 = 1.5707963267948966, c2 = 6.123233995736766e-17, c3 = -1.4973849048591698e-33;
-  const double shifted = std::fma(x, 0.63661977236758134, shift);
-  const double q = shifted - shift;
-  std::uint64_t bits;
-  std::memcpy(&bits, &shifted, sizeof bits);
+  const NearestInteger rounded = nearest_integer_of_product(x, 0.63661977236758134);  // x 2/pi
+  const double q = rounded.value;
+  const std::uint64_t bits = rounded.bits;
   const double r0 = std::fma(-q, c1, x);
   const double r1 = std::fma(-q, c2, r0);
   const double r = std::fma(-q, c3, r1);
@@ -95,16 +110,15 @@ __attribute__((always_inline)) inline SinCos host_sin_cos(const double x) {
   return {reduced ? (sin_negative ? -s : s) : quiet_nan(), reduced ? (cos_negative ? -c : c) : quiet_nan()};
 }
 
-/// exp x = 2^k exp r with k = round(x / ln 2) (the same shift as host_sin_cos) and |r| <= ln2 / 2 (ln 2 in two
+/// exp x = 2^k exp r with k = round(x / ln 2) (nearest_integer_of_product) and |r| <= ln2 / 2 (ln 2 in two
 /// doubles), exp r by its Taylor series to r^13 (truncated below 2^-57 relative), and 2^k applied as two powers of two,
 /// so that results in the subnormal range are rounded once. x is clamped to [-745.2, 709.8], past which exp is 0 and
 /// +inf. Within 1 ulp of long double's expl (test_math).
 __attribute__((always_inline)) inline double host_exp(const double x) {
-  constexpr double shift = 6755399441055744.0;  // 1.5 2^52
   constexpr double ln2_hi = 0.6931471805599453, ln2_lo = 2.3190468138462996e-17;
-  const double clamped = x > 709.8 ? 709.8 : (x < -745.2 ? -745.2 : x);  // NaN stays NaN
-  const double shifted = std::fma(clamped, 1.4426950408889634, shift);
-  const double k = shifted - shift;
+  const double clamped = x > 709.8 ? 709.8 : (x < -745.2 ? -745.2 : x);                    // NaN stays NaN
+  const NearestInteger rounded = nearest_integer_of_product(clamped, 1.4426950408889634);  // x / ln 2
+  const double k = rounded.value;
   const double r = std::fma(-k, ln2_lo, std::fma(-k, ln2_hi, clamped));
   double p = std::fma(1.0 / 6227020800.0, r, 1.0 / 479001600.0);  // 1 / 13!, 1 / 12!, ...
   p = std::fma(p, r, 1.0 / 39916800.0);
@@ -119,16 +133,10 @@ __attribute__((always_inline)) inline double host_exp(const double x) {
   p = std::fma(p, r, 0.5);
   p = std::fma(p, r, 1.0);
   p = std::fma(p, r, 1.0);
-  std::uint64_t k_bits, shift_bits;  // unsigned: a NaN's bits minus the shift's would overflow an int64
-  std::memcpy(&k_bits, &shifted, sizeof k_bits);
-  std::memcpy(&shift_bits, &shift, sizeof shift_bits);
-  const std::int64_t k_int = static_cast<std::int64_t>(k_bits - shift_bits), k1 = k_int >> 1, k2 = k_int - k1;
-  const std::uint64_t scale1_bits = static_cast<std::uint64_t>(k1 + 1023) << 52,  // k1, k2 in [-538, 512]
-      scale2_bits = static_cast<std::uint64_t>(k2 + 1023) << 52;
-  double scale1, scale2;
-  std::memcpy(&scale1, &scale1_bits, sizeof scale1);
-  std::memcpy(&scale2, &scale2_bits, sizeof scale2);
-  return p * scale1 * scale2;
+  const std::int64_t k_int = static_cast<std::int64_t>(rounded.bits), k1 = k_int >> 1, k2 = k_int - k1;
+  // 2^k1 and 2^k2 from their exponent fields (k1, k2 in [-538, 512]).
+  return p * from_bits(static_cast<std::uint64_t>(k1 + 1023) << 52) *
+         from_bits(static_cast<std::uint64_t>(k2 + 1023) << 52);
 }
 
 /// log x = k ln 2 + log m with x = 2^k m, m in [sqrt(2)/2, sqrt(2)) (subnormal x scaled by 2^54 first), and log m by
@@ -141,13 +149,10 @@ __attribute__((always_inline)) inline double host_log(const double x) {
   // a loop in which a select's arm would have to compute (a division or product may trap).
   const bool subnormal = x < 0x1p-1022;
   const double scaled = x * (subnormal ? 0x1p54 : 1.0);
-  std::uint64_t bits;  // unsigned arithmetic: a negative x's bits would overflow an int64, and k << 52 is negative
-  std::memcpy(&bits, &scaled, sizeof bits);
+  const std::uint64_t bits = bits_of(scaled);  // unsigned: a negative x's bits would overflow an int64, k << 52 too
   const std::uint64_t above_half_sqrt2 = bits - 0x3fe6a09e667f3bcdull;       // sqrt(2)/2's bits
   const std::int64_t k = static_cast<std::int64_t>(above_half_sqrt2) >> 52;  // x's exponent from there (arithmetic)
-  const std::uint64_t m_bits = bits - (static_cast<std::uint64_t>(k) << 52);
-  double m;
-  std::memcpy(&m, &m_bits, sizeof m);
+  const double m = from_bits(bits - (static_cast<std::uint64_t>(k) << 52));
   const double f = m - 1.0, s = f / (2.0 + f), z = s * s, w = z * z;
   const double t1 = w * (3.999999999940941908e-01 + w * (2.222219843214978396e-01 + w * 1.531383769920937332e-01));
   const double t2 =
@@ -158,14 +163,8 @@ __attribute__((always_inline)) inline double host_log(const double x) {
   const double log_x = dk * ln2_hi - ((half_f_squared - (s * (half_f_squared + R) + dk * ln2_lo)) - f);
   const double inf = 0x1p1023 * 2.0;
   const double special = x == 0.0 ? -inf : (x == inf ? inf : quiet_nan());
-  std::uint64_t log_bits, special_bits;
-  std::memcpy(&log_bits, &log_x, sizeof log_bits);
-  std::memcpy(&special_bits, &special, sizeof special_bits);
   const std::uint64_t regular = (x > 0.0) & (x < inf) ? ~0ull : 0ull;
-  const std::uint64_t result_bits = (log_bits & regular) | (special_bits & ~regular);
-  double result;
-  std::memcpy(&result, &result_bits, sizeof result);
-  return result;
+  return from_bits((bits_of(log_x) & regular) | (bits_of(special) & ~regular));
 }
 #endif
 

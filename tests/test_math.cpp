@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <vector>
 
 namespace kushner {
@@ -26,11 +25,7 @@ long double relative_error(double a, long double b) {
   return std::fabs(static_cast<long double>(a) - b) / std::ldexp(1.0L, std::max(exponent, -1021) - 53);
 }
 
-std::uint64_t bits_of(double v) {
-  std::uint64_t bits;
-  std::memcpy(&bits, &v, sizeof bits);
-  return bits;
-}
+using math::bits_of;
 
 TEST(HostSinCos, IsWithinItsErrorOfTheExactValues) {
   constexpr int points = 100000;
@@ -86,7 +81,7 @@ TEST(HostExpLog, AreWithinAnUlpOfTheExactValues) {
     worst_log = std::max(worst_log, relative_error(math::host_log(near_one), logl(near_one)));
   }
   EXPECT_LE(worst_exp, 1.0L);  // measured 0.87 (glibc's exp: 0.51)
-  EXPECT_LE(worst_log, 1.0L);  // measured 0.75 (glibc's log: 0.52)
+  EXPECT_LE(worst_log, 1.0L);  // 0.84 at random points on [0.5, 2] (glibc: 0.52)
 }
 
 TEST(HostExpLog, TakeTheirLimitsAndSpecialValues) {

@@ -13,7 +13,6 @@
 
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <string>
 
 namespace kushner {
@@ -156,11 +155,7 @@ TEST(ModelForms, EveryFormAModelHasDescribesItsDrift) {
 }
 
 /// The same bit patterns (a NaN too: range-bearing's dh/dx at the origin).
-std::uint64_t bits_of(double v) {
-  std::uint64_t b;
-  std::memcpy(&b, &v, sizeof b);
-  return b;
-}
+using math::bits_of;
 template <int R, int C>
 void expect_same_bits(const Mat<R, C>& a, const Mat<R, C>& b, const std::string& what) {
   for (int i = 0; i < R; ++i)
