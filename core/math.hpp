@@ -82,7 +82,9 @@ __attribute__((always_inline)) inline NearestInteger nearest_integer_of_product(
 /// sinl and cosl (test_math): at most 1.1 2^-53 in absolute value below the limit (glibc's sin: 0.5), within an ulp of
 /// the result for |x| <= pi/4 and near the zeros of either. sin(-0) is +0. Every multiply-add is a std::fma, so
 /// scalar and SIMD code give the same bits. Always inlined: a call in a loop stops GCC from vectorizing it.
-__attribute__((always_inline)) inline SinCos host_sin_cos(const double x) {
+/// host_sin_cos_below_limit: for |x| < host_sin_cos_limit (the caller bounds x: Box-Muller's angle 2 pi u), the same
+/// bits without the test.
+__attribute__((always_inline)) inline SinCos host_sin_cos_below_limit(const double x) {
   constexpr double c1 = 1.5707963267948966, c2 = 6.123233995736766e-17, c3 = -1.4973849048591698e-33;
   const NearestInteger rounded = nearest_integer_of_product(x, 0.63661977236758134);  // x 2/pi
   const double q = rounded.value;
@@ -106,8 +108,12 @@ __attribute__((always_inline)) inline SinCos host_sin_cos(const double x) {
   // sin x, cos x = (s, c), (c, -s), (-s, -c), (-c, s) for q mod 4 = 0, 1, 2, 3.
   const bool odd = (bits & 1) != 0, sin_negative = (bits & 2) != 0, cos_negative = ((bits + 1) & 2) != 0;
   const double s = odd ? cos_r : sin_r, c = odd ? sin_r : cos_r;
+  return {sin_negative ? -s : s, cos_negative ? -c : c};
+}
+__attribute__((always_inline)) inline SinCos host_sin_cos(const double x) {
+  const SinCos both = host_sin_cos_below_limit(x);
   const bool reduced = std::fabs(x) < host_sin_cos_limit;
-  return {reduced ? (sin_negative ? -s : s) : quiet_nan(), reduced ? (cos_negative ? -c : c) : quiet_nan()};
+  return {reduced ? both.sin : quiet_nan(), reduced ? both.cos : quiet_nan()};
 }
 
 /// exp x = 2^k exp r with k = round(x / ln 2) (nearest_integer_of_product) and |r| <= ln2 / 2 (ln 2 in two
@@ -143,13 +149,11 @@ __attribute__((always_inline)) inline double host_exp(const double x) {
 /// fdlibm's e_log.c (Sun Microsystems 1993): s = f / (2 + f) for f = m - 1, its minimax polynomial in s^2 and the
 /// same sums (not fused: the native build's -ffp-contract=off makes scalar and SIMD code round them alike). log 0 =
 /// -inf, log of a negative x or NaN is NaN, log inf = inf. Within 1 ulp of long double's logl (test_math).
-__attribute__((always_inline)) inline double host_log(const double x) {
+/// host_log_of_normal: log (2^-scale x) for a positive, normal, finite x (2^scale times a subnormal in host_log;
+/// Box-Muller's uniforms as they are), the same bits without the selects of the other cases.
+__attribute__((always_inline)) inline double host_log_of_normal(const double x, const int scale = 0) {
   constexpr double ln2_hi = 6.93147180369123816490e-01, ln2_lo = 1.90821492927058770002e-10;  // k ln2_hi exact
-  // Every operation is taken for every x and the special values are put in by selects of bits: GCC does not vectorize
-  // a loop in which a select's arm would have to compute (a division or product may trap).
-  const bool subnormal = x < 0x1p-1022;
-  const double scaled = x * (subnormal ? 0x1p54 : 1.0);
-  const std::uint64_t bits = bits_of(scaled);  // unsigned: a negative x's bits would overflow an int64, k << 52 too
+  const std::uint64_t bits = bits_of(x);  // unsigned: a negative x's bits would overflow an int64, k << 52 too
   const std::uint64_t above_half_sqrt2 = bits - 0x3fe6a09e667f3bcdull;       // sqrt(2)/2's bits
   const std::int64_t k = static_cast<std::int64_t>(above_half_sqrt2) >> 52;  // x's exponent from there (arithmetic)
   const double m = from_bits(bits - (static_cast<std::uint64_t>(k) << 52));
@@ -159,8 +163,14 @@ __attribute__((always_inline)) inline double host_log(const double x) {
       z * (6.666666666666735130e-01 +
            w * (2.857142874366239149e-01 + w * (1.818357216161805012e-01 + w * 1.479819860511658591e-01)));
   const double R = t2 + t1, half_f_squared = 0.5 * f * f;
-  const double dk = static_cast<double>(k - (subnormal ? 54 : 0));
-  const double log_x = dk * ln2_hi - ((half_f_squared - (s * (half_f_squared + R) + dk * ln2_lo)) - f);
+  const double dk = static_cast<double>(k - scale);
+  return dk * ln2_hi - ((half_f_squared - (s * (half_f_squared + R) + dk * ln2_lo)) - f);
+}
+__attribute__((always_inline)) inline double host_log(const double x) {
+  // Every operation is taken for every x and the special values are put in by selects of bits: GCC does not vectorize
+  // a loop in which a select's arm would have to compute (a division or product may trap).
+  const bool subnormal = x < 0x1p-1022;
+  const double log_x = host_log_of_normal(x * (subnormal ? 0x1p54 : 1.0), subnormal ? 54 : 0);
   const double inf = 0x1p1023 * 2.0;
   const double special = x == 0.0 ? -inf : (x == inf ? inf : quiet_nan());
   const std::uint64_t regular = (x > 0.0) & (x < inf) ? ~0ull : 0ull;
@@ -179,6 +189,15 @@ KOKKOS_FORCEINLINE_FUNCTION double exp(double x) {
 KOKKOS_FORCEINLINE_FUNCTION double log(double x) {
 #if KUSHNER_HOST_MATH
   return host_log(x);
+#else
+  return impl::log(x);
+#endif
+}
+
+/// log x for a positive, normal, finite x (Box-Muller's uniforms): log's bits, without its other cases on a host.
+KOKKOS_FORCEINLINE_FUNCTION double log_of_normal(double x) {
+#if KUSHNER_HOST_MATH
+  return host_log_of_normal(x);
 #else
   return impl::log(x);
 #endif
@@ -241,16 +260,36 @@ KOKKOS_FORCEINLINE_FUNCTION void sin_cos(double x, double& s, double& c) {
 #endif
 }
 
-/// Host: cos(2 pi u) as cos_sin_two_pi computes its c there, the same bits (one expression for both).
-inline double cos_two_pi_host(double u) { return cos(2.0 * pi * u); }
+/// Host: sin_cos of the angle 2 pi u for u in [0, 1] (cos_sin_two_pi and cos_two_pi_host: one expression for both),
+/// without host_sin_cos' test of its limit.
+inline SinCos sin_cos_two_pi_host(double u) {
+#if KUSHNER_HOST_MATH
+  return host_sin_cos_below_limit(2.0 * pi * u);
+#else
+  SinCos both;
+  sin_cos(2.0 * pi * u, both.sin, both.cos);
+  return both;
+#endif
+}
 
-/// c = cos(2 pi u), s = sin(2 pi u). On a GPU CUDA's sincospi: no range reduction and one polynomial pair for
-/// both (the angle 2 pi u is never rounded); elsewhere sin_cos of the rounded angle.
+/// Host: cos(2 pi u) as cos_sin_two_pi computes its c there, the same bits.
+inline double cos_two_pi_host(double u) {
+#if KUSHNER_HOST_MATH
+  return sin_cos_two_pi_host(u).cos;
+#else
+  return cos(2.0 * pi * u);
+#endif
+}
+
+/// c = cos(2 pi u), s = sin(2 pi u) for u in [0, 1]. On a GPU CUDA's sincospi: no range reduction and one polynomial
+/// pair for both (the angle 2 pi u is never rounded); elsewhere sin_cos of the rounded angle.
 KOKKOS_INLINE_FUNCTION void cos_sin_two_pi(double u, double& c, double& s) {
 #if KUSHNER_CUDA_DEVICE_PASS
   ::sincospi(2.0 * u, &s, &c);
 #else
-  sin_cos(2.0 * pi * u, s, c);  // c: cos_two_pi_host's bits
+  const SinCos both = sin_cos_two_pi_host(u);
+  s = both.sin;
+  c = both.cos;
 #endif
 }
 

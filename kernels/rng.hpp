@@ -114,7 +114,7 @@ struct NormalPair {
 };
 
 /// Box-Muller's radius sqrt(-2 ln u0), which both of a pair's normals (and a lone cosine normal) take.
-KOKKOS_INLINE_FUNCTION double box_muller_radius(double u0) { return math::sqrt(-2.0 * math::log(u0)); }
+KOKKOS_INLINE_FUNCTION double box_muller_radius(double u0) { return math::sqrt(-2.0 * math::log_of_normal(u0)); }
 
 /// Box-Muller: two independent standard normals sqrt(-2 ln u0) (cos 2 pi u1, sin 2 pi u1) from two uniforms.
 /// Returned by value: GCC does not vectorize the host particle kernel when they are written through references.

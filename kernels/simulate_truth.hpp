@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <type_traits>
 #include <utility>
+#include <vector>
 
 namespace kushner {
 
@@ -273,74 +274,104 @@ void require_truth_banks(const BankVector<MemSpace>& x, const BankVector<MemSpac
                   "observation bank has shape (" << observations.extent(0) << ", " << observations.extent(1) << ")");
 }
 
-/// Fewest members for which a host truth step goes by blocks of moment_block_size members (TruthStepBlocks) rather than
-/// by parallel_for_members' chunks of host_member_chunk: below it the blocks are too few to share among a host's
+/// Fewest members for which a host truth step goes by blocks of moment_block_size members (TruthSegmentBlocks) rather
+/// than by parallel_for_members' chunks of host_member_chunk: below it the blocks are too few to share among a host's
 /// threads (engine/filter_run.hpp's segments start at the same count).
 constexpr long truth_block_min_members = 16 * moment_block_size;
 
-/// A host truth step by blocks of moment_block_size members, each in runs of host_lane_capacity (run_member_runs: the
-/// truth's chunk function sets itself up once per 128 members instead of once per 32; the same bits), and, given
-/// `blocks`, the moments of the state it leaves: each column's block_statistic of FiniteRowValue, as
-/// ensemble_moments' one-thread form takes it (the same bits), by the thread that just wrote the block, while it is in
-/// that core's cache.
+/// Steps a host truth segment takes at most (TruthBank::step_segment): a block's columns stay in its core's cache
+/// through them, so the bank's x and dy go to and from memory once per segment instead of once per step (as the
+/// filter bank's segments: FilterBank::segment_steps).
+constexpr int truth_segment_steps = 16;
+
+/// A host truth segment by blocks of moment_block_size members: block b takes steps first_step .. first_step + steps -
+/// 1, each in runs of host_lane_capacity (run_member_runs: the truth's chunk function sets itself up once per 128
+/// members instead of once per 32), the same bits as a step at a time. At an output step (output_of[s] >= 0) the
+/// thread that just wrote the block leaves each column's block_statistic of FiniteRowValue, as ensemble_moments'
+/// one-thread form takes it (the same bits: finite_row_block_statistics), while it is in that core's cache: at rows +
+/// (output_of[s] num_blocks + b) 3 Columns, BlockStatistics' layout.
 template <class Step, class View, int Columns>
-struct TruthStepBlocks {
-  Step step;
+struct TruthSegmentBlocks {
+  Step first;  // step first_step's kernel; each step's time and index are set from it
   View x;
   int members;
-  BlockStatistics<Kokkos::HostSpace> blocks;  // (block, 3 Columns), or none: no moments
+  long first_step;
+  int steps;
+  double dt;
+  const int* output_of;  // per step of the segment: its output's index, or -1
+  double* rows;
+  int num_blocks;
 
   void operator()(const int b) const {
     const int begin = b * moment_block_size, end = block_end(b, members);
-    run_member_runs(step, begin, end);
-    if (blocks.extent(0) == 0) return;
-    for (int c = 0; c < Columns; ++c)
-      store_block_statistic(blocks, Columns, b, c, block_statistic(FiniteRowValue<View, Columns>{x, c}, begin, end));
+    Step step = first;
+    for (int s = 0; s < steps; ++s) {
+      const long k = first_step + s;
+      step.t = k * dt;  // simulate_truth_step's time, bit for bit
+      step.step = static_cast<std::uint32_t>(k);
+      run_member_runs(step, begin, end);
+      if (output_of[s] < 0) continue;
+      BlockStatistic statistics[Columns];
+      finite_row_block_statistics(x, begin, end, statistics);
+      double* const row = rows + (static_cast<std::size_t>(output_of[s]) * num_blocks + b) * 3 * Columns;
+      for (int c = 0; c < Columns; ++c) store_block_row(row, Columns, c, statistics[c]);
+    }
   }
 };
 
-/// Whether a host truth step of bank x goes by blocks (TruthStepBlocks).
+/// Whether a host truth step of bank x goes by blocks (TruthSegmentBlocks).
 inline bool truth_step_by_blocks(const BankVector<Kokkos::HostSpace>& x) {
   return static_cast<long>(x.extent(0)) >= truth_block_min_members;
 }
 
-/// TruthStepBlocks over every block of x; `blocks`: none, or (blocks of x, 3 state_dim) for the moments.
+/// TruthSegmentBlocks over every block of x: steps first_step .. first_step + output_of.size() - 1; `rows`: (outputs,
+/// blocks of x, 3 state_dim) doubles for the outputs that output_of names (none: no moments).
 template <class ExecSpace, class Model>
-void step_truth_blocks(const ExecSpace& space, const Model& model, const BankVector<Kokkos::HostSpace>& x,
-                       const BankVector<Kokkos::HostSpace>& observations, double t, double dt, Seed seed,
-                       std::uint32_t step, const BlockStatistics<Kokkos::HostSpace>& blocks) {
-  const int members = x.extent_int(0);
+void step_truth_segment(const ExecSpace& space, const Model& model, const BankVector<Kokkos::HostSpace>& x,
+                        const BankVector<Kokkos::HostSpace>& observations, const long first_step,
+                        const std::vector<int>& output_of, const double dt, const Seed seed, double* const rows) {
+  const int members = x.extent_int(0), num_blocks = static_cast<int>(moment_blocks(members));
+  const double t = first_step * dt;
   Kokkos::parallel_for(
-      "kushner::truth_step_blocks", Kokkos::RangePolicy<ExecSpace>(space, 0, static_cast<int>(moment_blocks(members))),
-      TruthStepBlocks<TruthStep<Model, Kokkos::HostSpace>, BankVector<Kokkos::HostSpace>, Model::state_dim>{
-          {model, x, observations, t, dt, seed, step}, x, members, blocks});
+      "kushner::truth_segment", Kokkos::RangePolicy<ExecSpace>(space, 0, num_blocks),
+      TruthSegmentBlocks<TruthStep<Model, Kokkos::HostSpace>, BankVector<Kokkos::HostSpace>, Model::state_dim>{
+          {model, x, observations, t, dt, seed, static_cast<std::uint32_t>(first_step)},
+          x,
+          members,
+          first_step,
+          static_cast<int>(output_of.size()),
+          dt,
+          output_of.data(),
+          rows,
+          num_blocks});
 }
 
-/// Advances every member of the bank by one step; `observations` receives dy (continuous time) or z[k+1]
-/// (discrete time). No fence: the caller fences before reading results on the host.
+/// Advances every member of the bank by step k, over [k dt, (k + 1) dt]; `observations` receives dy (continuous time)
+/// or z[k+1] (discrete time). No fence: the caller fences before reading results on the host.
 template <class ExecSpace, class Model, class MemSpace>
 void simulate_truth_step(const ExecSpace& space, const Model& model, const BankVector<MemSpace>& x,
-                         const BankVector<MemSpace>& observations, double t, double dt, Seed seed, std::uint32_t step) {
+                         const BankVector<MemSpace>& observations, const long k, const double dt, const Seed seed) {
   static_assert(Kokkos::SpaceAccessibility<ExecSpace, MemSpace>::accessible, "bank not accessible from ExecSpace");
   require_truth_banks<Model>(x, observations);
   if constexpr (std::is_same<MemSpace, Kokkos::HostSpace>::value) {
     if (truth_step_by_blocks(x)) {
-      step_truth_blocks(space, model, x, observations, t, dt, seed, step, {});
+      step_truth_segment(space, model, x, observations, k, {-1}, dt, seed, nullptr);
       return;
     }
   }
-  parallel_for_members("kushner::truth_step", space, x.extent(0),
-                       TruthStep<Model, MemSpace>{model, x, observations, t, dt, seed, step});
+  parallel_for_members(
+      "kushner::truth_step", space, x.extent(0),
+      TruthStep<Model, MemSpace>{model, x, observations, k * dt, dt, seed, static_cast<std::uint32_t>(k)});
 }
 
 /// simulate_truth_step, then ensemble_moments of the state it leaves (the same bits; over every rank: a collective
-/// call). By blocks on the host (TruthStepBlocks) in one pass: a reduction of its own read the whole state back from
+/// call). By blocks on the host (TruthSegmentBlocks) in one pass: a reduction of its own read the whole state back from
 /// memory, as much as a tenth of the cubic oscillator's step at 1e6 members (x and dy 32 MB, more than the caches
 /// hold; perf/filter_bank.md). On a GPU, or with few members, the two in turn. The block rows in `rows`.
 template <class ExecSpace, class Model, class MemSpace>
 EnsembleMoments simulate_truth_step_and_moments(const ExecSpace& space, const Model& model,
                                                 const BankVector<MemSpace>& x, const BankVector<MemSpace>& observations,
-                                                double t, double dt, Seed seed, std::uint32_t step,
+                                                const long k, const double dt, const Seed seed,
                                                 MomentRows<MemSpace>& rows) {
   if constexpr (std::is_same<MemSpace, Kokkos::HostSpace>::value) {
     if (truth_step_by_blocks(x)) {
@@ -348,12 +379,12 @@ EnsembleMoments simulate_truth_step_and_moments(const ExecSpace& space, const Mo
       const int members = x.extent_int(0);
       const BlockStatistics<MemSpace>& blocks =
           rows.rows(space, static_cast<int>(moment_blocks(members)), 3 * Model::state_dim);
-      step_truth_blocks(space, model, x, observations, t, dt, seed, step, blocks);
+      step_truth_segment(space, model, x, observations, k, {0}, dt, seed, blocks.data());
       space.fence();
       return moments_of_block_rows(blocks.data(), blocks.size(), Model::state_dim, members);
     }
   }
-  simulate_truth_step(space, model, x, observations, t, dt, seed, step);
+  simulate_truth_step(space, model, x, observations, k, dt, seed);
   return ensemble_moments(space, x, rows);
 }
 

@@ -1,11 +1,14 @@
 // Truth simulation step (Euler-Maruyama, all members in one kernel): member-steps per second, alone and with an output
-// step's moments after it, next to a deep_copy of the same bytes (the memory floor) in the same binary.
+// step's moments after it, next to a deep_copy of the same bytes (the memory floor) in the same binary; and the host's
+// segments of steps, as `kushner simulate` takes them.
 #include "engine/truth_bank.hpp"
 #include "models/cubic_oscillator_model.hpp"
 #include "models/sine_model.hpp"
 #include "perf/bench_timing.hpp"
 
 #include <benchmark/benchmark.h>
+
+#include <vector>
 
 namespace kushner {
 namespace {
@@ -35,6 +38,31 @@ void BM_OutputStep(benchmark::State& state) {
   using Space = Kokkos::DefaultExecutionSpace;
   TruthBank<Space, Model> bank(Space(), Model{}, state.range(0), 42);
   time_truth_steps(state, bank, /*moments=*/true);
+}
+
+/// `kushner simulate`'s host loop: segments of truth_segment_steps steps, each block of members through all of them in
+/// its core's cache (TruthBank::step_segment), the moments at every step (`output` 1, simulate's default where the
+/// output points are as many as the steps) or at none (0). Skipped where the bank steps one step at a time (a GPU).
+template <class Model>
+void BM_TruthSegment(benchmark::State& state) {
+  using Space = Kokkos::DefaultExecutionSpace;
+  const long members = state.range(0);
+  TruthBank<Space, Model> bank(Space(), Model{}, members, 42);
+  if (!bank.steps_in_segments()) {
+    state.SkipWithError("this backend steps one step at a time");
+    return;
+  }
+  const std::vector<char> outputs(truth_segment_steps, static_cast<char>(state.range(1)));
+  long k = 0;
+  for (auto _ : state) {
+    Kokkos::Timer timer;
+    benchmark::DoNotOptimize(bank.step_segment(k, 1e-3, outputs).size());
+    k += truth_segment_steps;
+    state.SetIterationTime(timer.seconds());
+  }
+  using C = benchmark::Counter;
+  state.counters["member_steps_per_s"] =
+      C(static_cast<double>(members) * truth_segment_steps, C::kIsIterationInvariantRate);
 }
 
 /// ensemble_moments of a bank's state alone (no step): `kept` 1 with block rows and a (page-locked on a GPU) host copy
@@ -67,6 +95,12 @@ BENCHMARK_TEMPLATE(BM_TruthStep, SineModel)->ArgName("members")->Arg(1 << 20)->A
 BENCHMARK_TEMPLATE(BM_StreamCopy, SineModel)->ArgName("members")->Arg(1000000)->UseManualTime();
 BENCHMARK_TEMPLATE(BM_TruthStep, CubicOscillatorModel)->ArgName("members")->Arg(1000000)->UseManualTime();
 BENCHMARK_TEMPLATE(BM_StreamCopy, CubicOscillatorModel)->ArgName("members")->Arg(1000000)->UseManualTime();
+BENCHMARK_TEMPLATE(BM_TruthSegment, SineModel)->ArgNames({"members", "output"})->Args({1000000, 1})->UseManualTime();
+BENCHMARK_TEMPLATE(BM_TruthSegment, CubicOscillatorModel)
+    ->ArgNames({"members", "output"})
+    ->Args({1000000, 1})
+    ->Args({1000000, 0})
+    ->UseManualTime();
 BENCHMARK_TEMPLATE(BM_OutputStep, SineModel)->ArgName("members")->Arg(1000000)->UseManualTime();
 BENCHMARK_TEMPLATE(BM_OutputStep, CubicOscillatorModel)->ArgName("members")->Arg(1000000)->UseManualTime();
 BENCHMARK_TEMPLATE(BM_Moments, SineModel)

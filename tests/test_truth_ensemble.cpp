@@ -1,7 +1,8 @@
 // The bank of truths against exact moments: scalar OU, a 2-D linear model, and Clark's discrete-time model.
 // Statistical tests: fixed seed, M = 1e5 members, tolerance 4 standard errors, and a perturbed model that
 // the same test must reject (so the test can fail). And the host's truth steps by blocks, with an output step's
-// moments in the same pass, against the chunks of one member kernel and ensemble_moments, bit for bit.
+// moments in the same pass, against the chunks of one member kernel and ensemble_moments, bit for bit; and its
+// segments (several steps per block) against steps one at a time, bit for bit.
 #include "core/eigen_dense.hpp"
 #include "engine/truth_bank.hpp"
 #include "models/clark_linear_model.hpp"
@@ -14,6 +15,8 @@
 
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <vector>
 
 namespace kushner {
 namespace {
@@ -217,6 +220,55 @@ TYPED_TEST(StepAndMoments, AreChunkStepsThenEnsembleMomentsBitForBit) {
     expect_truth_steps_to_be_chunks_then_moments<TypeParam>(CubicOscillatorModel{}, members);
     expect_truth_steps_to_be_chunks_then_moments<TypeParam>(ClarkLinearModel{}, members);
   }
+}
+
+/// TruthBank::step_segment against a twin bank stepped one step at a time (step, step_and_moments): the same states,
+/// observations and moments, bit for bit, over segments of 1, 3, 5 and truth_segment_steps steps with outputs
+/// anywhere or none, whole blocks and a short one, with a member that escaped (left out of every column by both).
+template <class Model>
+void expect_segments_to_be_steps_one_at_a_time(const Model& model, const long members) {
+  using Host = Kokkos::DefaultHostExecutionSpace;
+  TruthBank<Host, Model> segments(Host(), model, members, seed), steps(Host(), model, members, seed);
+  ASSERT_TRUE(segments.steps_in_segments()) << members << " members";
+  for (auto* b : {&segments, &steps}) b->state()(300, Model::state_dim - 1) = std::numeric_limits<double>::infinity();
+  std::vector<char> last_only(truth_segment_steps, 0);
+  last_only.back() = 1;
+  const double dt = 1e-2;
+  long k = 0;
+  for (const std::vector<char>& outputs :
+       {std::vector<char>{1}, std::vector<char>{0, 1, 1, 0, 1}, last_only, std::vector<char>{0, 0, 0}}) {
+    const std::vector<EnsembleMoments> got = segments.step_segment(k, dt, outputs);
+    std::vector<EnsembleMoments> expected;
+    for (const char output : outputs) {
+      if (output != 0)
+        expected.push_back(steps.step_and_moments(k, dt));
+      else
+        steps.step(k, dt);
+      ++k;
+    }
+    ASSERT_EQ(got.size(), expected.size()) << Model::name << ", to step " << k;
+    for (std::size_t o = 0; o < got.size(); ++o) {
+      EXPECT_EQ(got[o].mean, expected[o].mean) << Model::name << ", to step " << k << ", output " << o;
+      EXPECT_EQ(got[o].variance, expected[o].variance) << Model::name << ", to step " << k << ", output " << o;
+      EXPECT_EQ(got[o].non_finite, 1) << Model::name << ", to step " << k << ", output " << o;
+      EXPECT_EQ(got[o].members, members);
+    }
+  }
+  EXPECT_EQ(test::entries_not_the_same_bits(segments.state(), steps.state()), 0) << Model::name;
+  EXPECT_EQ(test::entries_not_the_same_bits(segments.observations(), steps.observations()), 0) << Model::name;
+}
+
+TEST(TruthSegments, AreStepsOneAtATimeBitForBit) {
+  const long members = truth_block_min_members + 37;
+  expect_segments_to_be_steps_one_at_a_time(SineModel{}, members);
+  expect_segments_to_be_steps_one_at_a_time(CubicOscillatorModel{}, members);
+  expect_segments_to_be_steps_one_at_a_time(ClarkLinearModel{}, members);
+  using Host = Kokkos::DefaultHostExecutionSpace;
+  EXPECT_FALSE(
+      (TruthBank<Host, SineModel>(Host(), SineModel{}, truth_block_min_members - 1, seed).steps_in_segments()));
+  TruthBank<Host, SineModel> bank(Host(), SineModel{}, members, seed);
+  EXPECT_THROW(bank.step_segment(0, 1e-2, std::vector<char>(truth_segment_steps + 1, 0)), std::logic_error);
+  EXPECT_THROW(bank.step_segment(0, 1e-2, {}), std::logic_error);
 }
 
 }  // namespace

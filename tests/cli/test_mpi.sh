@@ -60,6 +60,9 @@ check control control --model sine --members 600 --T 0.3 --dt 1e-2 --particles 6
 # are 20 blocks (shares of 6, 7, 7 over 3 ranks), the traced members on the first, middle and last rank.
 check segments compare --model sine --filters EKF,SOF,QLF,KBL --members 5000 --T 0.3 --dt 1e-2 --output-points 7 \
   --trajectory-members 4999,0,2600 --no-plots --seed 12
+# simulate from 4096 members steps 16 steps at a time (TruthBank::step_segment); 5000 members over 2 or 3 ranks are
+# shares below that, a step at a time: the same bytes both ways.
+check simulate-segments simulate --model cubic-oscillator --members 5000 --T 0.3 --dt 1e-2 --output-points 7 --seed 13
 # Fewer blocks than ranks: 40 members are one block, which the last rank holds; rank 0 (the writer) and, with 3
 # ranks, rank 1 hold none. Every command with the particle filter, continuous and discrete time.
 check few-compare compare --model sine --members 40 --T 0.2 --dt 1e-2 --particles 64 --enkbf-particles 16 \
