@@ -42,10 +42,14 @@ class TruthBank {
   /// Step k: [k dt, (k+1) dt].
   void step(long k, double dt) { simulate_truth_step(space_, model_, x_, observations_, k, dt, seed_); }
 
-  /// step(k, dt), then ensemble_moments(state()) (a collective call); in one pass on the host from
-  /// truth_block_min_members members (simulate_truth_step_and_moments).
+  /// step(k, dt), then ensemble_moments(state()) (a collective call, the same bits); on the host from
+  /// truth_block_min_members members a segment of one step, whose blocks leave their statistics while in their core's
+  /// cache (a reduction of its own read the whole state back from memory: as much as a tenth of the cubic
+  /// oscillator's step at 1e6 members, perf/filter_bank.md).
   EnsembleMoments step_and_moments(long k, double dt) {
-    return simulate_truth_step_and_moments(space_, model_, x_, observations_, k, dt, seed_, moment_rows_);
+    if (steps_in_segments()) return std::move(step_segment(k, dt, {1}).front());
+    step(k, dt);
+    return moments();
   }
 
   /// Whether step_segment may run: a host bank of truth_block_min_members members or more.

@@ -64,18 +64,56 @@ KOKKOS_INLINE_FUNCTION void add_block_lanes(const Value& value, const int begin,
   for_block_lanes(begin, end, [&](const int j, const int m) { add(j, value(m)); });
 }
 
-/// The lanes' squared deviations from `mean`, pairwise added; `Masked`: a non-finite value adds nothing.
-template <bool Masked, class Value>
-KOKKOS_INLINE_FUNCTION double block_squared_deviations(const Value& value, const int begin, const int end,
-                                                       const double mean) {
+/// The lanes' squared deviations of the finite values from `mean`, pairwise added (a non-finite value adds nothing).
+template <class Value>
+KOKKOS_INLINE_FUNCTION double masked_block_squared_deviations(const Value& value, const int begin, const int end,
+                                                              const double mean) {
   constexpr int L = moment_lanes;
   double ss[L];
   for (int j = 0; j < L; ++j) ss[j] = 0.0;
   add_block_lanes(value, begin, end, [&](const int j, const double v) {
-    const double d = !Masked || math::is_finite(v) ? v - mean : 0.0;
+    const double d = math::is_finite(v) ? v - mean : 0.0;
     ss[j] += d * d;
   });
   return pairwise_sum<L>(ss);
+}
+
+/// block_statistic's unmasked passes for G values of each member at once (values(m, v) sets v[0 .. G - 1]), each pass
+/// visiting a member once for all of them: the same sums in the same order as block_statistic of each value alone.
+/// False, s as it was, where the block is empty or a value's total is not finite (the masked passes take it then).
+template <int G, class Values>
+KOKKOS_INLINE_FUNCTION bool unmasked_block_statistics(const Values& values, const int begin, const int end,
+                                                      BlockStatistic (&s)[G]) {
+  constexpr int L = moment_lanes;
+  if (end <= begin) return false;
+  double sum[G][L];
+  for (int g = 0; g < G; ++g)
+    for (int j = 0; j < L; ++j) sum[g][j] = 0.0;
+  for_block_lanes(begin, end, [&](const int j, const int m) {
+    double v[G];
+    values(m, v);
+    for (int g = 0; g < G; ++g) sum[g][j] += v[g];
+  });
+  const double count = static_cast<double>(end - begin);
+  double mean[G];
+  for (int g = 0; g < G; ++g) {
+    const double total = pairwise_sum<L>(sum[g]);
+    if (!math::is_finite(total)) return false;
+    mean[g] = total / count;
+  }
+  double ss[G][L];
+  for (int g = 0; g < G; ++g)
+    for (int j = 0; j < L; ++j) ss[g][j] = 0.0;
+  for_block_lanes(begin, end, [&](const int j, const int m) {
+    double v[G];
+    values(m, v);
+    for (int g = 0; g < G; ++g) {
+      const double d = v[g] - mean[g];
+      ss[g][j] += d * d;
+    }
+  });
+  for (int g = 0; g < G; ++g) s[g] = {count, mean[g], pairwise_sum<L>(ss[g])};
+  return true;
 }
 }  // namespace detail
 
@@ -85,37 +123,31 @@ KOKKOS_INLINE_FUNCTION double block_squared_deviations(const Value& value, const
 /// divisions, made these reductions the slowest part of an output step on the host and on the GPU), 32 independent
 /// chains (a loop the host compiler vectorizes, and on a GPU one lane per thread of a warp: team_block_statistic),
 /// and the same bits on every backend and thread count (up to the multiply-adds a GPU contracts).
-/// A block whose values are all finite (every block but those with a diverged member) takes the passes unmasked: a
-/// non-finite value leaves its lane's sum, and so the lanes' total, infinite or NaN for good, so a finite total means
-/// every value was finite, and then the masked passes would add the same values in the same order: the same bits,
-/// with the count end - begin. The unmasked passes took half the time of the masked ones on the host (an output
-/// step's reductions, perf/filter_bank.md); a total that overflowed takes the masked passes too.
+/// A block whose values are all finite (every block but those with a diverged member) takes the passes unmasked
+/// (detail::unmasked_block_statistics): a non-finite value leaves its lane's sum, and so the lanes' total, infinite or
+/// NaN for good, so a finite total means every value was finite, and then the masked passes would add the same values
+/// in the same order: the same bits, with the count end - begin. The unmasked passes took half the time of the masked
+/// ones on the host (an output step's reductions, perf/filter_bank.md); a total that overflowed takes the masked
+/// passes too.
 template <class Value>
 KOKKOS_INLINE_FUNCTION BlockStatistic block_statistic(const Value& value, const int begin, const int end) {
   constexpr int L = moment_lanes;
+  BlockStatistic s[1];
+  if (detail::unmasked_block_statistics([&](const int m, double(&v)[1]) { v[0] = value(m); }, begin, end, s))
+    return s[0];
   double count[L], sum[L];
   for (int j = 0; j < L; ++j) count[j] = sum[j] = 0.0;
-  BlockStatistic s;
-  if (end <= begin) return s;
-  detail::add_block_lanes(value, begin, end, [&](const int j, const double v) { sum[j] += v; });
-  const double total = pairwise_sum<L>(sum);
-  if (math::is_finite(total)) {
-    s.count = static_cast<double>(end - begin);
-    s.mean = total / s.count;
-    s.m2 = detail::block_squared_deviations<false>(value, begin, end, s.mean);
-    return s;
-  }
-  for (int j = 0; j < L; ++j) sum[j] = 0.0;  // a total that overflowed, or a non-finite value: the masked passes
   detail::add_block_lanes(value, begin, end, [&](const int j, const double v) {
     const bool finite = math::is_finite(v);
     count[j] += finite ? 1.0 : 0.0;
     sum[j] += finite ? v : 0.0;
   });
-  s.count = pairwise_sum<L>(count);
-  if (s.count == 0.0) return s;
-  s.mean = pairwise_sum<L>(sum) / s.count;
-  s.m2 = detail::block_squared_deviations<true>(value, begin, end, s.mean);
-  return s;
+  BlockStatistic masked;
+  masked.count = pairwise_sum<L>(count);
+  if (masked.count == 0.0) return masked;
+  masked.mean = pairwise_sum<L>(sum) / masked.count;
+  masked.m2 = detail::masked_block_squared_deviations(value, begin, end, masked.mean);
+  return masked;
 }
 
 /// Members per lane in a block: a lane's values of a block fit in registers.
@@ -370,37 +402,12 @@ struct FiniteRowValue {
 template <int Columns, class View>
 KOKKOS_INLINE_FUNCTION void finite_row_block_statistics(const View& x, const int begin, const int end,
                                                         BlockStatistic (&s)[Columns]) {
-  constexpr int L = moment_lanes;
-  double sum[Columns][L];
-  for (int c = 0; c < Columns; ++c)
-    for (int j = 0; j < L; ++j) sum[c][j] = 0.0;
-  detail::for_block_lanes(begin, end, [&](const int j, const int m) {
+  const auto row = [&](const int m, double(&v)[Columns]) {
     const double poison = row_poison<Columns>(x, m);
-    for (int c = 0; c < Columns; ++c) sum[c][j] += x(m, c) + poison;
-  });
-  const double count = static_cast<double>(end - begin);
-  bool finite = end > begin;
-  double mean[Columns];
-  for (int c = 0; c < Columns; ++c) {
-    const double total = pairwise_sum<L>(sum[c]);
-    finite = finite && math::is_finite(total);
-    mean[c] = total / count;
-  }
-  if (!finite) {
-    for (int c = 0; c < Columns; ++c) s[c] = block_statistic(FiniteRowValue<View, Columns>{x, c}, begin, end);
-    return;
-  }
-  double ss[Columns][L];
-  for (int c = 0; c < Columns; ++c)
-    for (int j = 0; j < L; ++j) ss[c][j] = 0.0;
-  detail::for_block_lanes(begin, end, [&](const int j, const int m) {
-    const double poison = row_poison<Columns>(x, m);
-    for (int c = 0; c < Columns; ++c) {
-      const double d = x(m, c) + poison - mean[c];
-      ss[c][j] += d * d;
-    }
-  });
-  for (int c = 0; c < Columns; ++c) s[c] = {count, mean[c], pairwise_sum<L>(ss[c])};
+    for (int c = 0; c < Columns; ++c) v[c] = x(m, c) + poison;
+  };
+  if (detail::unmasked_block_statistics(row, begin, end, s)) return;
+  for (int c = 0; c < Columns; ++c) s[c] = block_statistic(FiniteRowValue<View, Columns>{x, c}, begin, end);
 }
 
 /// The columns of a bank x(member, column), each as FiniteRowValue (ensemble_moments).

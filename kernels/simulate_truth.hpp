@@ -364,28 +364,4 @@ void simulate_truth_step(const ExecSpace& space, const Model& model, const BankV
       TruthStep<Model, MemSpace>{model, x, observations, k * dt, dt, seed, static_cast<std::uint32_t>(k)});
 }
 
-/// simulate_truth_step, then ensemble_moments of the state it leaves (the same bits; over every rank: a collective
-/// call). By blocks on the host (TruthSegmentBlocks) in one pass: a reduction of its own read the whole state back from
-/// memory, as much as a tenth of the cubic oscillator's step at 1e6 members (x and dy 32 MB, more than the caches
-/// hold; perf/filter_bank.md). On a GPU, or with few members, the two in turn. The block rows in `rows`.
-template <class ExecSpace, class Model, class MemSpace>
-EnsembleMoments simulate_truth_step_and_moments(const ExecSpace& space, const Model& model,
-                                                const BankVector<MemSpace>& x, const BankVector<MemSpace>& observations,
-                                                const long k, const double dt, const Seed seed,
-                                                MomentRows<MemSpace>& rows) {
-  if constexpr (std::is_same<MemSpace, Kokkos::HostSpace>::value) {
-    if (truth_step_by_blocks(x)) {
-      require_truth_banks<Model>(x, observations);
-      const int members = x.extent_int(0);
-      const BlockStatistics<MemSpace>& blocks =
-          rows.rows(space, static_cast<int>(moment_blocks(members)), 3 * Model::state_dim);
-      step_truth_segment(space, model, x, observations, k, {0}, dt, seed, blocks.data());
-      space.fence();
-      return moments_of_block_rows(blocks.data(), blocks.size(), Model::state_dim, members);
-    }
-  }
-  simulate_truth_step(space, model, x, observations, k, dt, seed);
-  return ensemble_moments(space, x, rows);
-}
-
 }  // namespace kushner

@@ -23,10 +23,10 @@
 #   OUT=<dir> KUSHNER_PHASES="build run" perf/run_bank_gpu.sh
 #   ab     this tree against a baseline tree (KUSHNER_BANK_BASELINE, e.g. .baseline below, given this tree's
 #          perf/bench_filter_bank.cpp), both built light (bench_filter_bank, and test_ensemble_moments and
-#          test_filter_bank_segments for this tree; the models' shared instances off: a few minutes for both at once
-#          on 32 cores): the two tests, then the benchmarks KUSHNER_AB_BENCHMARKS picks (a regex; default
-#          BM_FilterBankOutputSteps: M = 1e6, every step an output step, and no output) in alternating rounds, and
-#          the kernel timer of one run of each
+#          test_filter_bank_segments for this tree, or the tests KUSHNER_AB_TESTS names; the models' shared instances
+#          off: a few minutes for both at once on 32 cores, 3 minutes on 16): the tests, then the benchmarks
+#          KUSHNER_AB_BENCHMARKS picks (a regex; default BM_FilterBankOutputSteps: M = 1e6, every step an output step,
+#          and no output) in alternating rounds, and the kernel timer of one run of each
 # A baseline on the same machine: another source tree (e.g. `git archive <rev>` extracted into the git-ignored
 # .baseline/, named in `carry`) built into its own directory, then its phases run as the new tree's:
 #   KUSHNER_BANK_SOURCE=.baseline KUSHNER_BANK_BUILD=build-cuda-bank-old KUSHNER_PHASES=build perf/run_bank_gpu.sh
@@ -177,16 +177,16 @@ if want ab; then
   log "ab: build $old_tree and this tree (light)"
   light "$old_tree" "$here/build-cuda-ab-old" bench_filter_bank &
   old_pid=$!
-  light "$here" "$here/build-cuda-ab-new" bench_filter_bank test_ensemble_moments test_filter_bank_segments ||
-    { status=1; echo "new build failed"; }
+  ab_tests=(${KUSHNER_AB_TESTS:-test_ensemble_moments test_filter_bank_segments})
+  light "$here" "$here/build-cuda-ab-new" bench_filter_bank "${ab_tests[@]}" || { status=1; echo "new build failed"; }
   wait $old_pid || { status=1; echo "old build failed"; }
   grep -h -B2 -A10 -m3 " error" "$out"/build_build-cuda-ab-*.log | head -40
   log "ab: built"
-  "$here/build-cuda-ab-new/tests/test_ensemble_moments" > "$out/ab_test_ensemble_moments.log" 2>&1 || status=1
-  grep -E "^\[  (PASSED|FAILED)|FAILED \]" "$out/ab_test_ensemble_moments.log" | tee -a "$out/steps.log"
-  "$here/build-cuda-ab-new/tests/test_filter_bank_segments" > "$out/ab_test_filter_bank_segments.log" 2>&1 || status=1
-  grep -E "^\[  (PASSED|FAILED|SKIPPED)|FAILED \]|SKIPPED \]" "$out/ab_test_filter_bank_segments.log" |
-    tee -a "$out/steps.log"
+  for test in "${ab_tests[@]}"; do
+    log "ab: $test"
+    "$here/build-cuda-ab-new/tests/$test" > "$out/ab_$test.log" 2>&1 || status=1
+    grep -E "^\[  (PASSED|FAILED|SKIPPED)|FAILED \]|SKIPPED \]" "$out/ab_$test.log" | tee -a "$out/steps.log"
+  done
   for round in 1 2 3; do
     for which in old new; do
       log "ab: round $round, $which"
