@@ -43,8 +43,8 @@ for rep in range(1, reps + 1):
     loop.append(members * steps / (s[long]["step_loop_s"] - s[short]["step_loop_s"]))
     w = dict(line.split() for line in open("%s/wall-%d" % (work, rep)))
     wall.append(members * steps / (float(w[long]) - float(w[short])))
-print("kushner CLI (CUDA): step loop %.3g member-steps/s (median of %s), whole command %.3g" %
-      (statistics.median(loop), ["%.3g" % r for r in loop], statistics.median(wall)))
+print("kushner CLI (CUDA): step loop %.4g member-steps/s (median of %s), whole command %.4g" %
+      (statistics.median(loop), ["%.4g" % r for r in loop], statistics.median(wall)))
 PY
 python3 "$(dirname "$0")/bank_jax.py" --members "$members" --T "$long" --rate "$short" --repetitions "$reps"
 # The same bank with the command line's statuses, score sums and moments at every step (its output steps here).
