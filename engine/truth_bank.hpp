@@ -86,7 +86,7 @@ class TruthBank {
     return moments;
   }
 
-  /// ensemble_moments(state()) with step_and_moments' rows (a collective call).
+  /// ensemble_moments(state()) (a collective call), its block rows kept from call to call (moment_rows_).
   EnsembleMoments moments() { return ensemble_moments(space_, x_, moment_rows_); }
 
   const BankVector<MemSpace>& state() const { return x_; }
