@@ -293,17 +293,6 @@ KOKKOS_INLINE_FUNCTION void cos_sin_two_pi(double u, double& c, double& s) {
 #endif
 }
 
-/// cos_sin_two_pi in float (CUDA's sincospif on a GPU).
-KOKKOS_INLINE_FUNCTION void cos_sin_two_pi(float u, float& c, float& s) {
-#if KUSHNER_CUDA_DEVICE_PASS
-  ::sincospif(2.0f * u, &s, &c);
-#else
-  constexpr float pi_f = static_cast<float>(pi);
-  c = cos(2.0f * pi_f * u);  // two expressions of one angle: GCC does not fuse them into sincosf (no vector version)
-  s = sin(pi_f * (2.0f * u));
-#endif
-}
-
 /// log(cosh(x)) without overflow for large |x|.
 KOKKOS_INLINE_FUNCTION double log_cosh(double x) {
   const double a = fabs(x);

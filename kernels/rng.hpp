@@ -10,9 +10,10 @@
 // Normals: each Philox block (4 x 32 bits) gives two 52-bit uniforms u1, u2 in (0, 1), and Box-Muller
 // turns them into two independent standard normals sqrt(-2 ln u1) (cos 2 pi u2, sin 2 pi u2). Box-Muller,
 // not a rejection method, so every member uses the same number of blocks per step and counters stay aligned.
-// The fp32 variant (the particle filter's `mixed` precision) takes 23-bit uniforms from the same blocks' high
-// words (the top bits of the 52-bit ones) and runs Box-Muller in float: the same normals to about 1e-7,
-// with the radius cut at sqrt(48 ln 2) = 5.77 (probability 2^-24 beyond it).
+// The fp32 variant (the particle filter's `mixed` and `fp32` precisions) takes 23-bit uniforms from the same blocks'
+// high words (the top bits of the 52-bit ones) and runs Box-Muller in float (on a GPU by its special-function unit):
+// the same normals to about 1e-7 on a host and a few 1e-7 on a GPU, with the radius cut at sqrt(48 ln 2) = 5.77
+// (probability 2^-24 beyond it).
 // The truths take component i of their N normals from block i / 2 (normal_vector; a continuous-time truth's
 // observation and process normals are one vector of the process-noise stream, and where their count is odd two
 // neighbouring members share the last one's block: truth_normals);
@@ -129,13 +130,32 @@ KOKKOS_INLINE_FUNCTION NormalPair box_muller(double u0, double u1) {
 /// z1 would take is not computed.
 inline double box_muller_cosine_host(double u0, double u1) { return box_muller_radius(u0) * math::cos_two_pi_host(u1); }
 
-/// box_muller in float (the particle filter's `mixed` precision): a GPU's fp32 log, sqrt and sincospi cost a
-/// fraction of their fp64 versions; the normals are returned as doubles for the fp64 state.
+/// box_muller in float (the particle filter's `mixed` and `fp32` precisions); the normals are returned as doubles
+/// for mixed's fp64 state. On a GPU from the special-function unit: log2, reciprocal square root, sine and cosine
+/// (MUFU) in place of CUDA's logf, sqrtf and sincospif, in a particle step bound by instruction issue (fp32's fused
+/// pair: 162 -> 138 thread instructions per particle-step, perf/particle_filter.md). By CUDA's bounds (log2: 2^-22
+/// absolute on [0.5, 2], 2 ulp elsewhere; rsqrt 2 ulp; sine and cosine 2^-21.41 absolute on [-pi, pi]) a normal of
+/// radius r is within about 1.7e-7 / r + 1.2e-6 r of the accurate one (tests/test_rng.cpp checks each draw against
+/// twice that): about 1e-6 in the bulk, up to 6e-4 for the radii below 1e-3 that one draw in 2e6 has. Elsewhere
+/// libm's (libmvec's in the host's SIMD lanes), to a float's last bits.
 KOKKOS_INLINE_FUNCTION NormalPair box_muller_fp32(float u0, float u1) {
+#if KUSHNER_CUDA_DEVICE_PASS
+  // -2 ln u0 = -2 ln 2 log2 u0. Near u0 = 1 the log2's absolute error can give 0 or a tiny negative value: the floor
+  // at the smallest normal float keeps the reciprocal square root finite (and the radius about 0).
+  const float r2 = fmaxf(-1.38629436f * __log2f(u0), 0x1.0p-126f);
+  const float radius = r2 * rsqrtf(r2);
+  // The angle 2 pi u1 - pi in (-pi, pi), where the sine and cosine units hold their bound: cos 2 pi u1 = -cos of it.
+  float s, c;
+  __sincosf(fmaf(u1, 6.28318548f, -3.14159274f), &s, &c);
+  return {static_cast<double>(-radius * c), static_cast<double>(-radius * s)};
+#else
   const float radius = math::sqrt(-2.0f * math::log(u0));
-  float c, s;
-  math::cos_sin_two_pi(u1, c, s);
+  constexpr float pi_f = static_cast<float>(math::pi);
+  // Two expressions of one angle: GCC does not fuse them into sincosf, which has no vector version.
+  const float c = math::cos(2.0f * pi_f * u1);
+  const float s = math::sin(pi_f * (2.0f * u1));
   return {static_cast<double>(radius * c), static_cast<double>(radius * s)};
+#endif
 }
 
 /// Two independent standard normals from one Philox block (Box-Muller).

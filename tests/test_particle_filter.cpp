@@ -550,8 +550,9 @@ TEST(ParticleFilterBank, DeviceMatchesHostToTwelveDigits) {
 }
 
 TEST(ParticleFilterBank, MixedAndFp32DeviceMatchesHostToFloatRounding) {
-  // fp32 normals: CUDA's logf, sqrtf and sincospif against glibc's differ in a float's last bit (about 1e-7 of
-  // a normal); 40 steps with resampling, step() and step_pair. Most members agree to that level. A member whose
+  // fp32 normals: the GPU's Box-Muller by its special-function unit against glibc's logf, sqrtf, cosf and sinf differ
+  // by about 1e-6 of a normal (kernels/rng.hpp); 40 steps with resampling, step() and step_pair. Most members agree
+  // to 1e-5. A member whose
   // resampling took one other index (a cumulative weight within float rounding of a systematic point) goes its own
   // way from there, and each later resampling flips more indices, since the flip shifts every later cumulative
   // weight: host and device in lockstep on an H200 (fp32, seed 20261122's member 1) agreed to 2e-8 for 16 steps,

@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <iostream>
 #include <set>
+#include <utility>
 #include <vector>
 
 namespace kushner {
@@ -83,6 +85,55 @@ TYPED_TEST(PhiloxNormals, KolmogorovSmirnovAcceptsNormalAndRejectsScaledNormal) 
   // Power: a 2% error in the standard deviation must be detected on the same draws.
   const double d_scaled = ks_statistic(draw_normals<TypeParam>(Stream::process_noise, num_draws, 1.02));
   EXPECT_GT(d_scaled, critical) << "KS statistic of scaled draws " << d_scaled;
+}
+
+/// Block i's float uniforms u(i, 0..1) and box_muller_fp32's normals of them z(i, 0..1), computed on ExecSpace.
+template <class ExecSpace>
+void draw_float_box_muller(int blocks, Kokkos::View<float* [2], Kokkos::LayoutRight, Kokkos::HostSpace>& u,
+                           Kokkos::View<double* [2], Kokkos::LayoutRight, Kokkos::HostSpace>& z) {
+  using Memory = typename ExecSpace::memory_space;
+  Kokkos::View<float* [2], Kokkos::LayoutRight, Memory> uniforms("uniforms", blocks);
+  Kokkos::View<double* [2], Kokkos::LayoutRight, Memory> normals("normals", blocks);
+  Kokkos::parallel_for(
+      "test::float_box_muller", Kokkos::RangePolicy<ExecSpace>(0, blocks), KOKKOS_LAMBDA(const int i) {
+        float u0, u1;
+        uniform_pair_fp32(RngKey{seed, Stream::particle_noise}, Counter{std::uint32_t(i), 1, 2, 0}, u0, u1);
+        const NormalPair pair = box_muller_fp32(u0, u1);
+        uniforms(i, 0) = u0;
+        uniforms(i, 1) = u1;
+        normals(i, 0) = pair.z0;
+        normals(i, 1) = pair.z1;
+      });
+  u = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), uniforms);
+  z = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), normals);
+}
+
+/// The float Box-Muller (mixed and fp32 particles) against the double one on the same float uniforms, each normal
+/// within twice its bound (kernels/rng.hpp: the GPU's special-function unit; libm's on the host, within a sixth of
+/// it: its float angle's rounding), and the float normals' mean and variance within four standard errors.
+TYPED_TEST(PhiloxNormals, FloatBoxMullerIsWithinItsBoundOfTheDoubleOne) {
+  constexpr int blocks = num_draws / 2;
+  Kokkos::View<float* [2], Kokkos::LayoutRight, Kokkos::HostSpace> u;
+  Kokkos::View<double* [2], Kokkos::LayoutRight, Kokkos::HostSpace> z;
+  draw_float_box_muller<TypeParam>(blocks, u, z);
+  int outside = 0;
+  double worst = 0.0, sum = 0.0, squares = 0.0;
+  for (int i = 0; i < blocks; ++i) {
+    const NormalPair exact = box_muller(u(i, 0), u(i, 1));
+    const double r = std::hypot(exact.z0, exact.z1);
+    const double bound = 2.0 * (std::min(std::sqrt(3.3e-7), 1.65e-7 / r) + 1.2e-6 * r) + 1e-7;
+    for (const auto& [fast, accurate] : {std::pair{z(i, 0), exact.z0}, std::pair{z(i, 1), exact.z1}}) {
+      outside += !(std::abs(fast - accurate) <= bound);
+      worst = std::max(worst, std::abs(fast - accurate) / bound);
+      sum += fast;
+      squares += fast * fast;
+    }
+  }
+  EXPECT_EQ(outside, 0) << "largest error over its bound " << worst;
+  const double n = num_draws, mean = sum / n, variance = squares / n - mean * mean;
+  EXPECT_LT(std::abs(mean), 4.0 / std::sqrt(n)) << "mean " << mean;
+  EXPECT_LT(std::abs(variance - 1.0), 4.0 * std::sqrt(2.0 / n)) << "variance " << variance;
+  std::cout << "largest error over its bound " << worst << "\n";
 }
 
 TEST(PhiloxStreams, DistinctStreamsShareNoBlockAndAreUncorrelated) {
