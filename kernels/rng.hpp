@@ -12,7 +12,7 @@
 // not a rejection method, so every member uses the same number of blocks per step and counters stay aligned.
 // The fp32 variant (the particle filter's `mixed` and `fp32` precisions) takes 23-bit uniforms from the same blocks'
 // high words (the top bits of the 52-bit ones) and runs Box-Muller in float (on a GPU by its special-function unit):
-// the same normals to about 1e-7 on a host and a few 1e-7 on a GPU, with the radius cut at sqrt(48 ln 2) = 5.77
+// the same normals to about 1e-7 on a host and about 1e-6 on a GPU, with the radius cut at sqrt(48 ln 2) = 5.77
 // (probability 2^-24 beyond it).
 // The truths take component i of their N normals from block i / 2 (normal_vector; a continuous-time truth's
 // observation and process normals are one vector of the process-noise stream, and where their count is odd two

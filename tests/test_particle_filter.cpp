@@ -551,14 +551,13 @@ TEST(ParticleFilterBank, DeviceMatchesHostToTwelveDigits) {
 
 TEST(ParticleFilterBank, MixedAndFp32DeviceMatchesHostToFloatRounding) {
   // fp32 normals: the GPU's Box-Muller by its special-function unit against glibc's logf, sqrtf, cosf and sinf differ
-  // by about 1e-6 of a normal (kernels/rng.hpp); 40 steps with resampling, step() and step_pair. Most members agree
-  // to 1e-5. A member whose
-  // resampling took one other index (a cumulative weight within float rounding of a systematic point) goes its own
-  // way from there, and each later resampling flips more indices, since the flip shifts every later cumulative
-  // weight: host and device in lockstep on an H200 (fp32, seed 20261122's member 1) agreed to 2e-8 for 16 steps,
-  // then moved 2.6 / N at the first resampling and 18 / N by step 39 after two more, 0.28 of the member's Monte
-  // Carlo standard error sd / sqrt(N). So at least 9 of the 12 members agree to float rounding, and every member
-  // within what two runs with independent particles would meet, 3 sqrt(2) sd / sqrt(N).
+  // by about 1e-6 of a normal (kernels/rng.hpp); 40 steps with resampling, step() and step_pair. Most members agree to
+  // 1e-5. A member whose resampling took one other index (a cumulative weight within float rounding of a systematic
+  // point) goes its own way from there, and each later resampling flips more indices, since the flip shifts every later
+  // cumulative weight: host and device in lockstep on an H200 (fp32, seed 20261122's member 1) agreed to 2e-8 for 16
+  // steps, then moved 2.6 / N at the first resampling and 18 / N by step 39 after two more, 0.28 of the member's Monte
+  // Carlo standard error sd / sqrt(N). So at least 9 of the 12 members agree to 1e-5, and every member within what two
+  // runs with independent particles would meet, 3 sqrt(2) sd / sqrt(N).
   for (auto precision : {ParticlePrecision::mixed, ParticlePrecision::fp32}) {
     ParticleFilterOptions options;
     options.precision = precision;
