@@ -141,9 +141,9 @@ inline double box_muller_cosine_host(double u0, double u1) { return box_muller_r
 KOKKOS_INLINE_FUNCTION NormalPair box_muller_fp32(float u0, float u1) {
 #if KUSHNER_CUDA_DEVICE_PASS
   // -2 ln u0 = -2 ln 2 log2 u0. Near u0 = 1 the log2's absolute error can give 0 or a tiny negative value: the floor
-  // at the smallest normal float keeps the reciprocal square root finite (and the radius about 0). Their PTX in its
-  // .ftz forms: neither input is ever subnormal (u0 >= 2^-24, the floor), and __log2f's and rsqrtf's forms take 7
-  // more instructions for subnormal inputs.
+  // at the smallest normal float keeps the reciprocal square root finite (and the radius about 0). Both as PTX in
+  // their .ftz forms: neither input is ever subnormal (u0 >= 2^-24, the floor), and the forms that __log2f and rsqrtf
+  // emit take 7 more instructions for subnormal inputs.
   float log2_u0, inverse_radius;
   asm("lg2.approx.ftz.f32 %0, %1;" : "=f"(log2_u0) : "f"(u0));
   const float r2 = fmaxf(-1.38629436f * log2_u0, 0x1.0p-126f);
