@@ -154,16 +154,20 @@ __attribute__((always_inline)) inline double host_exp(const double x) {
 __attribute__((always_inline)) inline double host_log_of_normal(const double x, const int scale = 0) {
   constexpr double ln2_hi = 6.93147180369123816490e-01, ln2_lo = 1.90821492927058770002e-10;  // k ln2_hi exact
   const std::uint64_t bits = bits_of(x);  // unsigned: a negative x's bits would overflow an int64, k << 52 too
-  const std::uint64_t above_half_sqrt2 = bits - 0x3fe6a09e667f3bcdull;       // sqrt(2)/2's bits
-  const std::int64_t k = static_cast<std::int64_t>(above_half_sqrt2) >> 52;  // x's exponent from there (arithmetic)
-  const double m = from_bits(bits - (static_cast<std::uint64_t>(k) << 52));
+  // k + 1024 with k = x's exponent counted from sqrt(2)/2 (0x3fe6a09e667f3bcd: its bits), by a logical shift of a
+  // sum that stays in [0, 2^64) for every positive x: AVX2 has no 64-bit arithmetic shift.
+  const std::uint64_t k_biased = (bits - 0x3fe6a09e667f3bcdull + (1024ull << 52)) >> 52;
+  const double m = from_bits(bits - (k_biased << 52) + (1024ull << 52));
   const double f = m - 1.0, s = f / (2.0 + f), z = s * s, w = z * z;
   const double t1 = w * (3.999999999940941908e-01 + w * (2.222219843214978396e-01 + w * 1.531383769920937332e-01));
   const double t2 =
       z * (6.666666666666735130e-01 +
            w * (2.857142874366239149e-01 + w * (1.818357216161805012e-01 + w * 1.479819860511658591e-01)));
   const double R = t2 + t1, half_f_squared = 0.5 * f * f;
-  const double dk = static_cast<double>(k - scale);
+  // k - scale as a double from bits: 2^52 + k_biased is exact, and so is the difference of two such integers. A
+  // static_cast of an int64 has no AVX2 instruction (AVX-512DQ's vcvtqq2pd): it kept every loop that takes a log
+  // (Box-Muller's) scalar there.
+  const double dk = from_bits(0x4330000000000000ull | k_biased) - (0x1.0p52 + 1024.0 + scale);
   return dk * ln2_hi - ((half_f_squared - (s * (half_f_squared + R) + dk * ln2_lo)) - f);
 }
 __attribute__((always_inline)) inline double host_log(const double x) {
