@@ -96,7 +96,8 @@ struct DiscreteGaussianGridStep {
       s[a] = math::sqrt(Q(a, a));
     }
     // 1. The new grid.
-    Vec<D> f_min, f_max;
+    // Set by the first occupied cell; where no cell is, the grid is unusable below and these zeros are not used.
+    Vec<D> f_min = Vec<D>::constant(0.0), f_max = f_min;
     bool occupied = false;
     for (int c = 0; c < n_cells; ++c) {
       if (!(mass(c, member) > 0.0)) continue;
