@@ -7,3 +7,6 @@ set(KUSHNER_CUDA_EXTRA_SASS "sm_90" CACHE STRING "")
 set(KUSHNER_CUDA_EXTRA_SASS_ONLY ON CACHE BOOL "")
 set(KUSHNER_INSTANCE_UNITS 22 CACHE STRING "")
 set(KUSHNER_COMMAND_UNITS 16 CACHE STRING "")
+# perf/run_gpu_validation.sh runs 8 tests at a time with 2 host threads each (OMP_NUM_THREADS=2 ctest -j8): each
+# asks ctest for 2 cores, not all 16 (tests/CMakeLists.txt).
+set(KUSHNER_TEST_PROCESSORS 2 CACHE STRING "")
