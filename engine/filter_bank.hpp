@@ -24,6 +24,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <deque>
+#include <memory>
 #include <optional>
 #include <string>
 #include <tuple>
@@ -178,18 +180,22 @@ class FilterBank {
   /// Whether a run should call step_pair: the reference advances in pairs (ReferenceEstimator::advances_in_pairs).
   bool steps_in_pairs() const { return reference_ != nullptr && reference_->advances_in_pairs(); }
 
-  /// Steps k and k + 1 (`record`: (k + 2) dt is an output time; (k + 1) dt must not be one), the reference
-  /// taking both in one advance_pair. Step k's scores against the reference and the outside estimators' scores
-  /// wait for it: what they read of step k (the truths, their statuses and dy, each filter's m and status) is
-  /// kept before the bank takes step k + 1. Every score gets the same terms in the same order as step(k, dt,
-  /// false) then step(k + 1, dt, record), so the numbers are those of the two steps wherever the reference's pair
-  /// is (ParticleFilterBank::step_pair).
-  void step_pair(long k, double dt, bool record);
+  /// Steps k and k + 1 (`record`: (k + 2) dt is an output time), the reference taking both in one advance_pair.
+  /// Step k's scores against the reference and the outside estimators' scores wait for it: what they read of step k
+  /// (the truths, their statuses and dy, each filter's m, status and snapshot columns) is kept before the bank takes
+  /// step k + 1. Every score gets the same terms in the same order as step(k, dt, first_output) then step(k + 1,
+  /// dt, record), so the numbers are those of the two steps wherever the reference's pair is
+  /// (ParticleFilterBank::step_pair). `first_output`: the names of the filters whose snapshots at (k + 1) dt, an
+  /// output time, are started in the pair (as start_snapshots(*first_output) after step k would): finish_snapshots
+  /// gives them after those started before the call and before those started after it. An observer that reads the
+  /// bank at (k + 1) dt cannot run then: the bank is at (k + 2) dt (engine/filter_run.hpp takes single steps).
+  void step_pair(long k, double dt, bool record, const std::vector<std::string>* first_output = nullptr);
 
-  /// Bytes step_pair keeps per member for `filters` filters: a step's truth, dy and statuses, each filter's m.
+  /// Bytes step_pair keeps per member for `filters` filters: a step's truth, dy and statuses, each filter's m,
+  /// status and snapshot columns.
   static double step_pair_bytes_per_member(long filters) {
     return sizeof(double) * (n + p) + sizeof(Status) +
-           static_cast<double>(filters) * (sizeof(double) * n + sizeof(Status));
+           static_cast<double>(filters) * (sizeof(double) * (n + num_snapshot_columns) + sizeof(Status));
   }
 
   /// Whether start_segment may run: no estimator steps beside the bank.
@@ -257,19 +263,7 @@ class FilterBank {
   /// Calls f(slot) with the slot of filter `name` (a selected one).
   template <class F>
   void with_slot(const std::string& name, F&& f) const {
-    bool found = false;
-    for_each_filter_slot(slots_, [&](const auto& slot) {
-      if (slot.enabled && name == decltype(slot.filter)::name) {
-        found = true;
-        f(slot);
-      }
-    });
-    for (const auto& e : estimators_)
-      if (!found && e.name == name) {
-        found = true;
-        f(e.slot);
-      }
-    KUSHNER_REQUIRE(found, "filter '" << name << "' is not in this bank");
+    with_slot_in(slots_, name, f);
   }
 
   /// The selected filters of the bank (not the outside estimators), in slot order.
@@ -305,13 +299,15 @@ class FilterBank {
   /// snapshot() of every filter of `names`: the moments of all their snapshot columns and their divergence counts
   /// in one launch (ColumnMoments with NotOkMembers), whatever the number of filters.
   std::vector<FilterSnapshot> snapshots(const std::vector<std::string>& names) const {
+    KUSHNER_REQUIRE(pending_.empty(), "snapshots: started snapshots are not finished");
     start_snapshots(names);
     return finish_snapshots();
   }
 
   /// snapshots() in two halves: start_snapshots queues the reductions of the bank's present time and their copies
-  /// to the host; finish_snapshots waits for them (not for work queued since) and gives the snapshots. Between the
-  /// two the bank may take its next step: on a GPU the host's merge then runs beside it (engine/filter_run.hpp).
+  /// to the host; finish_snapshots waits for the oldest started (not for work queued since) and gives its snapshots.
+  /// Between the two the bank may take its next steps: on a GPU the host's merge then runs beside them
+  /// (engine/filter_run.hpp).
   void start_snapshots(const std::vector<std::string>& names) const;
   std::vector<FilterSnapshot> finish_snapshots() const;
 
@@ -346,15 +342,17 @@ class FilterBank {
     return {truths_.state(), truth_status_, reference_->mean(), reference_->status()};
   }
 
-  /// step_pair's copy of step k: truths, statuses, dy, and slots whose m and status are copies of step k's (their
-  /// scores, snapshots and filters are the bank's own).
+  /// step_pair's copy of step k: truths, statuses, dy, and slots whose m, status and snapshot are copies of step
+  /// k's (their scores and filters are the bank's own).
   struct KeptStep {
     BankVector<MemSpace> truth, dy;
     BankScalar<Status, MemSpace> truth_status;
     typename K::Slots slots;
   };
 
-  void keep_step() {
+  /// `snapshots`: step k ends at an output time, so its snapshot columns are kept too (step k + 1 writes the
+  /// bank's own when it ends at one).
+  void keep_step(bool snapshots) {
     if (kept_.truth.extent(0) == 0) {
       kept_.truth = BankVector<MemSpace>("kushner::truth_kept", members_, n);
       kept_.dy = BankVector<MemSpace>("kushner::dy_kept", members_, p);
@@ -365,6 +363,7 @@ class FilterBank {
         const std::string name = decltype(slot.filter)::name;
         kept.m = BankVector<MemSpace>("kushner::m_kept_" + name, members_, n);
         kept.status = BankScalar<Status, MemSpace>("kushner::status_kept_" + name, members_);
+        kept.snapshot = BankVector<MemSpace>("kushner::snapshot_kept_" + name, members_, num_snapshot_columns);
       });
     }
     Kokkos::deep_copy(space_, kept_.truth, truths_.state());
@@ -374,6 +373,7 @@ class FilterBank {
       if (!slot.enabled) return;
       Kokkos::deep_copy(space_, kept.m, slot.m);
       Kokkos::deep_copy(space_, kept.status, slot.status);
+      if (snapshots) Kokkos::deep_copy(space_, kept.snapshot, slot.snapshot);
     });
   }
   template <class F>
@@ -386,6 +386,29 @@ class FilterBank {
        static_cast<const FilterSlot<Filters, MemSpace>&>(slots_)),
      ...);
   }
+
+  /// with_slot among `slots` (the bank's own, or kept_.slots) and the outside estimators' slots.
+  template <class F>
+  void with_slot_in(const typename K::Slots& slots, const std::string& name, F&& f) const {
+    bool found = false;
+    for_each_filter_slot(slots, [&](const auto& slot) {
+      if (slot.enabled && name == decltype(slot.filter)::name) {
+        found = true;
+        f(slot);
+      }
+    });
+    for (const auto& e : estimators_)
+      if (!found && e.name == name) {
+        found = true;
+        f(e.slot);
+      }
+    KUSHNER_REQUIRE(found, "filter '" << name << "' is not in this bank");
+  }
+
+  /// start_snapshots of the bank's filters in `slots` (the bank's own, or kept_.slots in a step pair) and of the
+  /// outside estimators, the truths' statuses `truth_status`.
+  void start_snapshots_of(const std::vector<std::string>& names, const typename K::Slots& slots,
+                          const BankScalar<Status, MemSpace>& truth_status) const;
 
   bool scored_against_reference(const std::string& name) const {
     return reference_ != nullptr && name != reference_->name();
@@ -465,14 +488,35 @@ class FilterBank {
   ReferenceEstimator<MemSpace>* reference_ = nullptr;
   std::vector<Estimator> estimators_;
   KeptStep kept_;
-  mutable ColumnMoments<ExecSpace> snapshot_moments_;  // buffers kept from one output step to the next
-  mutable DivergedMembers<MemSpace> diverged_members_;
-  struct PendingSnapshots {
-    bool started = false;
-    std::vector<std::string> names;
-    std::vector<int> first;  // names[i]'s first column in snapshot_moments_
+  mutable DivergedMembers<MemSpace> diverged_members_;  // a segment's
+  /// The buffers of an output time's reductions, kept from one output time to the next (on a GPU an allocation, and
+  /// a change of the columns' addresses, waits for the device).
+  struct SnapshotBuffers {
+    ColumnMoments<ExecSpace> moments;
+    DivergedMembers<MemSpace> diverged;
+    const void* slots = nullptr;  // the slots whose columns they reduced last: taken again for the same slots
   };
-  mutable PendingSnapshots pending_;
+  struct PendingSnapshots {
+    std::vector<std::string> names;
+    std::vector<int> first;  // names[i]'s first column in buffers->moments
+    SnapshotBuffers* buffers = nullptr;
+  };
+  /// Buffers free of pending snapshots, for the columns of `slots`: the same addresses as the last time where a
+  /// free set last reduced them.
+  SnapshotBuffers& free_snapshot_buffers(const void* slots) const {
+    SnapshotBuffers* free = nullptr;
+    for (const auto& buffers : snapshot_buffers_) {
+      const bool in_use = std::any_of(pending_.begin(), pending_.end(),
+                                      [&](const PendingSnapshots& p) { return p.buffers == buffers.get(); });
+      if (!in_use && (free == nullptr || buffers->slots == slots)) free = buffers.get();
+    }
+    if (free == nullptr) free = snapshot_buffers_.emplace_back(std::make_unique<SnapshotBuffers>()).get();
+    free->slots = slots;
+    return *free;
+  }
+  mutable std::vector<std::unique_ptr<SnapshotBuffers>> snapshot_buffers_;
+  // Oldest first; at most three where every step ends at an output time and pairs start one in their middle.
+  mutable std::deque<PendingSnapshots> pending_;
   /// What both forms of start_segment need: per step its output's index (or -1), the snapshot columns of `names`
   /// (host form: with their places in the sink), their divergence counts, the watched elements (values not set).
   struct SegmentPlan {
@@ -579,19 +623,23 @@ void FilterBank<ExecSpace, Model, TruthModel>::step(long k, double dt, bool reco
 }
 
 template <class ExecSpace, class Model, class TruthModel>
-void FilterBank<ExecSpace, Model, TruthModel>::step_pair(long k, double dt, bool record) {
+void FilterBank<ExecSpace, Model, TruthModel>::step_pair(long k, double dt, bool record,
+                                                         const std::vector<std::string>* first_output) {
   KUSHNER_REQUIRE(steps_in_pairs(), "step_pair: the reference does not advance in pairs");
-  run_step_kernel(k, dt, false);
-  keep_step();
+  const bool record_first = first_output != nullptr;
+  run_step_kernel(k, dt, record_first);
+  keep_step(record_first);
   run_step_kernel(k + 1, dt, record);
   reference_->advance_pair(k, k * dt, dt, kept_.dy, truths_.observations());
   const EstimateViews<MemSpace> reference_then = reference_->first_of_pair();
   const ScoredTime then{kept_.truth, kept_.truth_status, reference_then.mean, reference_then.status};
   for (auto& e : estimators_)
     if (e.estimator != reference_) e.estimator->advance(k, k * dt, dt, kept_.dy);
-  score_reference(kept_.slots, then, false);
+  score_reference(kept_.slots, then, record_first);
   for (auto& e : estimators_)
-    score_estimator(e, e.estimator == reference_ ? reference_then : e.estimator->estimate(), then, false);
+    score_estimator(e, e.estimator == reference_ ? reference_then : e.estimator->estimate(), then, record_first);
+  // Queued before step k + 1's scores overwrite the estimators' snapshot columns (the bank's are kept).
+  if (record_first) start_snapshots_of(*first_output, kept_.slots, kept_.truth_status);
   for (auto& e : estimators_)
     if (e.estimator != reference_) e.estimator->advance(k + 1, (k + 1) * dt, dt, truths_.observations());
   score_now(record);
@@ -612,29 +660,37 @@ std::vector<char> FilterBank<ExecSpace, Model, TruthModel>::members_ok(const std
 
 template <class ExecSpace, class Model, class TruthModel>
 void FilterBank<ExecSpace, Model, TruthModel>::start_snapshots(const std::vector<std::string>& names) const {
-  KUSHNER_REQUIRE(!pending_.started, "start_snapshots: the previous snapshots were not finished");
+  start_snapshots_of(names, slots_, truth_status_);
+}
+
+template <class ExecSpace, class Model, class TruthModel>
+void FilterBank<ExecSpace, Model, TruthModel>::start_snapshots_of(
+    const std::vector<std::string>& names, const typename K::Slots& slots,
+    const BankScalar<Status, MemSpace>& truth_status) const {
   std::vector<typename ColumnMoments<ExecSpace>::Column> columns;
   std::vector<BankScalar<Status, MemSpace>> statuses;
-  pending_.first.clear();
+  PendingSnapshots pending;
+  pending.names = names;
   for (const auto& name : names)
-    with_slot(name, [&](const auto& slot) {
-      pending_.first.push_back(static_cast<int>(columns.size()));
+    with_slot_in(slots, name, [&](const auto& slot) {
+      pending.first.push_back(static_cast<int>(columns.size()));
       columns.push_back(Kokkos::subview(slot.snapshot, Kokkos::ALL, int(snapshot_squared_error)));
       columns.push_back(Kokkos::subview(slot.snapshot, Kokkos::ALL, int(snapshot_nees)));
       if (scored_against_reference(name))
         columns.push_back(Kokkos::subview(slot.snapshot, Kokkos::ALL, int(snapshot_reference_squared_error)));
       statuses.push_back(slot.status);
     });
-  snapshot_moments_.start(space_, columns, diverged_members_(space_, statuses, truth_status_));
-  pending_.names = names;
-  pending_.started = true;
+  pending.buffers = &free_snapshot_buffers(&slots);
+  pending.buffers->moments.start(space_, columns, pending.buffers->diverged(space_, statuses, truth_status));
+  pending_.push_back(std::move(pending));
 }
 
 template <class ExecSpace, class Model, class TruthModel>
 std::vector<FilterSnapshot> FilterBank<ExecSpace, Model, TruthModel>::finish_snapshots() const {
-  KUSHNER_REQUIRE(pending_.started, "finish_snapshots: no snapshots started");
-  pending_.started = false;
-  return snapshots_of(snapshot_moments_.finish(), pending_.names, pending_.first);
+  KUSHNER_REQUIRE(!pending_.empty(), "finish_snapshots: no snapshots started");
+  const PendingSnapshots pending = std::move(pending_.front());
+  pending_.pop_front();
+  return snapshots_of(pending.buffers->moments.finish(), pending.names, pending.first);
 }
 
 template <class ExecSpace, class Model, class TruthModel>

@@ -186,11 +186,11 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
   // An output time's metrics are queued when the bank reaches it and collected once the next step is queued (or
   // before a checkpoint, or at the end): on a GPU the host merges them while the device takes that step. A segment's
   // likewise, once the next segment is queued (FilterBank::start_segment).
-  bool collecting = false;
+  int collecting = 0;  // output times whose metrics are queued, not yet collected
   const auto record = [&](double t) {
     report.times.push_back(t);
     bank.start_snapshots(report.filters);
-    collecting = true;
+    ++collecting;
     if (observer.observe) observer.observe(t, bank, outside_view, nullptr);
   };
   struct StartedSegment {
@@ -211,10 +211,10 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
         ++o;
       }
   };
-  const auto collect_step = [&] {
-    if (collecting) report.series.push_back(bank.finish_snapshots());
-    collecting = false;
+  const auto collect_oldest = [&](int count) {  // the `count` oldest queued output times
+    for (; count > 0; --count, --collecting) report.series.push_back(bank.finish_snapshots());
   };
+  const auto collect_step = [&] { collect_oldest(collecting); };
   const auto collect = [&] {
     collect_step();
     while (!started_segments.empty()) collect_segment();
@@ -290,16 +290,23 @@ FilterReport run_filters(const ExecSpace& space, const TruthModel& truth_model, 
     if (segments) {
       k = take_segment(k);
     } else {
-      // Two steps at a time where the reference takes them in one pass (FilterBank::step_pair), unless the first
-      // ends at an output time (its metrics are read there) or is the last.
-      const bool pair = bank.steps_in_pairs() && !ends_at_output(k + 1) && k + 2 <= grid.steps;
+      // Two steps at a time where the reference takes them in one pass (FilterBank::step_pair), unless the first is
+      // the last, or ends at an output time where an observer reads the bank (it would be a step further on).
+      const bool first_output = ends_at_output(k + 1);
+      const bool pair = bank.steps_in_pairs() && !(first_output && observer.observe) && k + 2 <= grid.steps;
+      const int queued_before = collecting;
+      if (pair && first_output) {  // its metrics are queued in the pair
+        report.times.push_back((k + 1) * grid.dt);
+        ++collecting;
+        ++next_output;
+      }
       const long done = k + (pair ? 2 : 1);
       const bool output = ends_at_output(done);
       if (pair)
-        bank.step_pair(k, grid.dt, output);
+        bank.step_pair(k, grid.dt, output, first_output ? &report.filters : nullptr);
       else
         bank.step(k, grid.dt, output);
-      collect();
+      collect_oldest(queued_before);  // not the pair's own: the host would wait for the device
       k = done;
       if (output) {
         record(k * grid.dt);
