@@ -162,13 +162,12 @@ struct EulerMaruyamaTruthStep {
   KUSHNER_FLATTEN void draw_lanes(const int begin, const int end, double* const z) const {
     const RngKey key{seed, Stream::process_noise};
     const std::uint32_t k = step;
-    const auto counter_of = [k](const int member, const int draw) {
-      return Counter{static_cast<std::uint32_t>(member), 0, k, static_cast<std::uint32_t>(draw)};
-    };
     const int drawn = truth_normal_count(model);
-    for (int i = 0; i + 1 < drawn; i += 2)
-      draw_block_lanes(begin, end, key, counter_of, i / 2, z + i * host_lane_capacity,
+    for (int i = 0; i + 1 < drawn; i += 2) {
+      const Counter first{static_cast<std::uint32_t>(begin), 0, k, static_cast<std::uint32_t>(i / 2)};
+      draw_block_lanes(key, {first, Counter{1, 0, 0, 0}}, end - begin, z + i * host_lane_capacity,
                        z + (i + 1) * host_lane_capacity);
+    }
     if (drawn % 2 == 1)  // z's row holds host_lane_capacity (even) values: room for an odd chunk's last z1
       draw_member_pair_normal_lanes(begin, end, key, k, static_cast<std::uint32_t>(drawn / 2),
                                     z + (drawn - 1) * host_lane_capacity);

@@ -1,7 +1,8 @@
-// The host particle kernel's vectorizable Philox (kernels/particle_filter/simd_random.hpp) against Random123's
-// (kernels/rng.hpp, used on the GPU): the same uniforms bit for bit, the same normals to the last bits of the
-// math library; the particle pairs' draws (kernels/particle_filter/particle_draws.hpp), in fp64 and in the
-// `mixed` precision's fp32; and the truths' member pairs (an odd count's last normal: truth_normals).
+// The host's Philox (kernels/particle_filter/simd_random.hpp: the scalar rounds GCC vectorizes, and the runs of lanes
+// that an AVX2 host draws four at a time) against Random123's (kernels/rng.hpp, used on the GPU): the same uniforms bit
+// for bit, the same normals to the last bits of the math library; the particle pairs' draws
+// (kernels/particle_filter/particle_draws.hpp), in fp64 and in the `mixed` precision's fp32; and the truths' member
+// pairs (an odd count's last normal: truth_normals).
 #include "kernels/for_each_member.hpp"
 #include "kernels/particle_filter/particle_draws.hpp"
 
@@ -9,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace kushner {
 namespace {
@@ -31,15 +33,68 @@ TEST(SimdPhilox, UniformsBitIdenticalToRandom123) {
           }
 }
 
+/// Lane counts that fill eight-lane and four-lane bodies and leave each remainder, up to two draw pieces.
+constexpr int lane_counts[] = {1, 2, 3, 4, 5, 7, 8, 9, 11, 12, 13, 16, 31, 64, 65, 100, 128};
+
+TEST(SimdPhilox, LaneRunsBitIdenticalToRandom123) {
+  // uniform_pair_lanes and uniform_pair_fp32_lanes against Random123 lane by lane: each field as the lanes' stride
+  // (members, particles, member pairs, steps), counters that wrap past 2^32 within a run, a process's first member.
+  const Counter strides[] = {{1, 0, 0, 0}, {0, 1, 0, 0}, {2, 0, 0, 0}, {0, 0, 3, 0}, {0, 0, 0, 1}};
+  const Counter firsts[] = {{0, 0, 0, 0}, {5, 255, 999999, 2}, {0xfffffff0u, 0xffffffc0u, 7, 0xfffffffeu}};
+  for (const std::uint32_t first_member : {0u, 1u, 0xfffffff9u})
+    for (const Counter& first : firsts)
+      for (const Counter& stride : strides)
+        for (const int lanes : lane_counts) {
+          const RngKey key{Seed(20261205, first_member), Stream::particle_noise};
+          const simd::LaneCounters c{first, stride};
+          double u0[128], u1[128];
+          float f0[128], f1[128];
+          simd::uniform_pair_lanes(key, c, lanes, u0, u1);
+          simd::uniform_pair_fp32_lanes(key, c, lanes, f0, f1);
+          for (int j = 0; j < lanes; ++j) {
+            double a0, a1;
+            float g0, g1;
+            uniform_pair(key, c(j), a0, a1);
+            uniform_pair_fp32(key, c(j), g0, g1);
+            ASSERT_EQ(u0[j], a0) << lanes << " lanes, lane " << j << ", stride " << stride.member << stride.particle
+                                 << stride.step << stride.draw << ", first member " << first_member;
+            ASSERT_EQ(u1[j], a1) << lanes << " lanes, lane " << j;
+            ASSERT_EQ(f0[j], g0) << lanes << " lanes, lane " << j;
+            ASSERT_EQ(f1[j], g1) << lanes << " lanes, lane " << j;
+          }
+        }
+}
+
+/// draw_pair_lanes<Fp32> of `pairs` pairs of (member, first_pair.., step, block i) into z, compiled once for every
+/// count (draw_lane_normals_apart's reason, below).
+template <bool Fp32>
+KUSHNER_SAME_CODE_FOR_ALL_CALLERS void draw_pairs_apart(const RngKey& key, const int member, const int first_pair,
+                                                        const int pairs, const std::uint32_t step, const int i,
+                                                        double* const z) {
+  draw_pair_lanes<Fp32>(key, particle_pair_lanes(member, first_pair, step, i), pairs, z);
+}
+
+/// The host's normals of `pairs` particle pairs from first_pair on (draw_pair_lanes), as NormalPairs.
+template <bool Fp32 = false>
+std::vector<NormalPair> host_pair_normals(const RngKey& key, const int member, const int first_pair, const int pairs,
+                                          const std::uint32_t step, const int i) {
+  std::vector<double> z(2 * static_cast<std::size_t>(pairs));
+  draw_pairs_apart<Fp32>(key, member, first_pair, pairs, step, i, z.data());
+  std::vector<NormalPair> out(pairs);
+  for (int k = 0; k < pairs; ++k) out[k] = {z[2 * k], z[2 * k + 1]};
+  return out;
+}
+
 TEST(SimdPhilox, ParticlePairDrawsMatchRandom123) {
   const RngKey key{7, Stream::particle_initial};
-  for (int pair = 0; pair < 2000; ++pair)
-    for (int i = 0; i < 3; ++i) {
-      const NormalPair a = pair_normals<Random123Draws>(key, 5, pair, 11, i);
-      const NormalPair b = pair_normals<SimdDraws>(key, 5, pair, 11, i);
-      ASSERT_NEAR(a.z0, b.z0, 1e-15 * (1.0 + std::abs(a.z0))) << pair << " " << i;
-      ASSERT_NEAR(a.z1, b.z1, 1e-15 * (1.0 + std::abs(a.z1))) << pair << " " << i;
+  for (int i = 0; i < 3; ++i) {
+    const std::vector<NormalPair> host = host_pair_normals(key, 5, 0, 2000, 11, i);
+    for (int pair = 0; pair < 2000; ++pair) {
+      const NormalPair a = pair_normals(key, 5, pair, 11, i);
+      ASSERT_NEAR(a.z0, host[pair].z0, 1e-15 * (1.0 + std::abs(a.z0))) << pair << " " << i;
+      ASSERT_NEAR(a.z1, host[pair].z1, 1e-15 * (1.0 + std::abs(a.z1))) << pair << " " << i;
     }
+  }
 }
 
 TEST(ParticleDraws, PairFollowsTheDocumentedBlocks) {
@@ -49,15 +104,18 @@ TEST(ParticleDraws, PairFollowsTheDocumentedBlocks) {
   for (std::uint32_t i = 0; i < 2; ++i) {
     double z0, z1;
     normal_pair(key, Counter{3, 17, 9, i}, z0, z1);
-    const NormalPair z = pair_normals<Random123Draws>(key, 3, 17, 9, static_cast<int>(i));
+    const NormalPair z = pair_normals(key, 3, 17, 9, static_cast<int>(i));
     EXPECT_EQ(z.z0, z0);
     EXPECT_EQ(z.z1, z1);
   }
-  double u0, u1, v0, v1;
+  double u0, u1, v0[1], v1[1], w0, w1;
   uniform_pair(key, Counter{3, 17, 9, 2}, u0, u1);
-  pair_uniforms<SimdDraws>(key, 3, 17, 9, 2, v0, v1);
-  EXPECT_EQ(v0, u0);
-  EXPECT_EQ(v1, u1);
+  simd::uniform_pair_lanes(key, particle_pair_lanes(3, 17, 9, 2), 1, v0, v1);
+  pair_uniforms(key, 3, 17, 9, 2, w0, w1);
+  EXPECT_EQ(v0[0], u0);
+  EXPECT_EQ(v1[0], u1);
+  EXPECT_EQ(w0, u0);
+  EXPECT_EQ(w1, u1);
 }
 
 constexpr int lane_stride = 128;
@@ -68,10 +126,7 @@ constexpr int lane_stride = 128;
 /// last bits differ.
 template <int N>
 KUSHNER_SAME_CODE_FOR_ALL_CALLERS void draw_lane_normals_apart(const RngKey& key, const int lanes, double* const z) {
-  const auto counter_of = [](const int lane, const int draw) {
-    return Counter{static_cast<std::uint32_t>(lane), 0, 7, static_cast<std::uint32_t>(draw)};
-  };
-  draw_normal_lanes<N>(0, lanes, key, counter_of, z, lane_stride);
+  draw_normal_lanes<N>(key, {Counter{0, 0, 7, 0}, Counter{1, 0, 0, 0}}, lanes, z, lane_stride);
 }
 
 TEST(ParticleDraws, OddCountOfLaneNormalsTakesTheLastBlocksCosineNormalBitForBit) {
@@ -79,7 +134,7 @@ TEST(ParticleDraws, OddCountOfLaneNormalsTakesTheLastBlocksCosineNormalBitForBit
   // N + 1 normals (both of that block's), for lane counts that fill vector bodies and leave remainders.
   const RngKey key{20261129, Stream::process_noise};
   constexpr int stride = lane_stride;
-  for (const int lanes : {1, 3, 8, 13, 16, 32, 45, 100, 128}) {
+  for (const int lanes : lane_counts) {
     double one[stride], two[2 * stride], three[3 * stride], four[4 * stride];
     draw_lane_normals_apart<1>(key, lanes, one);
     draw_lane_normals_apart<2>(key, lanes, two);
@@ -163,8 +218,7 @@ TEST(ParticleDraws, PairedNormalsAreUncorrelatedUnitNormals) {
   const int pairs = 1 << 20;
   const RngKey key{11, Stream::particle_noise};
   double see = 0.0, soo = 0.0, seo = 0.0;
-  for (int k = 0; k < pairs; ++k) {
-    const NormalPair z = pair_normals<SimdDraws>(key, 2, k, 4, 0);
+  for (const NormalPair& z : host_pair_normals(key, 2, 0, pairs, 4, 0)) {
     see += z.z0 * z.z0;
     soo += z.z1 * z.z1;
     seo += z.z0 * z.z1;
@@ -184,7 +238,8 @@ TEST(SimdPhilox, ExtremeWordsGiveTheOpenIntervalEnds) {
 
 TEST(MixedPrecisionDraws, Fp32UniformsAreTheTopBitsOfTheFp64OnesOnBothPhiloxes) {
   // The same blocks' high words: within half a 2^-23 step (plus the fp64 offset) of the fp64 uniforms, the same
-  // floats from both Philox implementations, and the interval's ends (k + 1/2) 2^-23 exactly.
+  // floats from the scalar rounds as from Random123 (LaneRunsBitIdenticalToRandom123: from the host's runs of lanes),
+  // and the interval's ends (k + 1/2) 2^-23 exactly.
   for (std::uint32_t member = 0; member < 40; member += 3)
     for (std::uint32_t particle : {0u, 1u, 255u, 65535u, 0xfffffffeu})
       for (std::uint32_t step : {0u, 3u, 999999u}) {
@@ -193,8 +248,8 @@ TEST(MixedPrecisionDraws, Fp32UniformsAreTheTopBitsOfTheFp64OnesOnBothPhiloxes) 
         double a0, a1;
         float f0, f1, g0, g1;
         uniform_pair(key, c, a0, a1);
-        Random123Draws::uniforms_fp32(key, c, f0, f1);
-        SimdDraws::uniforms_fp32(key, c, g0, g1);
+        uniform_pair_fp32(key, c, f0, f1);
+        simd::uniform_pair_fp32(key, c, g0, g1);
         ASSERT_EQ(f0, g0);
         ASSERT_EQ(f1, g1);
         ASSERT_LE(std::abs(f0 - a0), 0x1.0p-24);
@@ -207,26 +262,27 @@ TEST(MixedPrecisionDraws, Fp32UniformsAreTheTopBitsOfTheFp64OnesOnBothPhiloxes) 
 
 TEST(MixedPrecisionDraws, Fp32NormalsAgreeWithTheFp64OnesToFloatRounding) {
   // Box-Muller in float against the double one on the same float uniforms: float rounding only (log, sqrt,
-  // cos, sin: a few 6e-8 relative steps, times a radius of at most 5.77), on both Philoxes. Against the fp64
-  // normals (52-bit uniforms of the same blocks) the uniforms' rounding (at most 2^-24) moves the radius r by
-  // up to 2^-24 / (u0 r) and the point across it by 2 pi 2^-24 r: each pair within that plus float rounding.
+  // cos, sin: a few 6e-8 relative steps, times a radius of at most 5.77), a GPU thread's and the host's. Against the
+  // fp64 normals (52-bit uniforms of the same blocks) the uniforms' rounding (at most 2^-24) moves the radius r by up
+  // to 2^-24 / (u0 r) and the point across it by 2 pi 2^-24 r: each pair within that plus float rounding.
   const RngKey key{5, Stream::particle_noise};
   double worst = 0.0;
-  for (int pair = 0; pair < 100000; ++pair) {
+  const int pairs = 100000;
+  const std::vector<NormalPair> host = host_pair_normals<true>(key, 9, 0, pairs, 2, 0);
+  for (int pair = 0; pair < pairs; ++pair) {
     const Counter c{9, std::uint32_t(pair), 2, 0};
     double u0, u1;
     float f0, f1;
     uniform_pair(key, c, u0, u1);
-    Random123Draws::uniforms_fp32(key, c, f0, f1);
+    uniform_pair_fp32(key, c, f0, f1);
     const NormalPair exact = box_muller(f0, f1);
     const double r = std::hypot(exact.z0, exact.z1);
-    for (const NormalPair z :
-         {pair_normals<Random123Draws, true>(key, 9, pair, 2, 0), pair_normals<SimdDraws, true>(key, 9, pair, 2, 0)}) {
+    for (const NormalPair z : {pair_normals<true>(key, 9, pair, 2, 0), host[pair]}) {
       ASSERT_NEAR(z.z0, exact.z0, 1e-6 * (1.0 + r)) << pair;
       ASSERT_NEAR(z.z1, exact.z1, 1e-6 * (1.0 + r)) << pair;
     }
-    const NormalPair a = pair_normals<Random123Draws>(key, 9, pair, 2, 0);
-    const NormalPair b = pair_normals<Random123Draws, true>(key, 9, pair, 2, 0);
+    const NormalPair a = pair_normals(key, 9, pair, 2, 0);
+    const NormalPair b = pair_normals<true>(key, 9, pair, 2, 0);
     const double ra = std::hypot(a.z0, a.z1);
     if (ra < 1e-3) continue;  // the radius' bound grows without limit as u0 -> 1
     const double bound = 0x1.0p-24 / (u0 * ra) + 2.0 * math::pi * 0x1.0p-24 * ra + 1e-6 * (1.0 + ra);
@@ -242,8 +298,7 @@ TEST(MixedPrecisionDraws, Fp32NormalsAreUnitNormals) {
   const int pairs = 1 << 20;
   const RngKey key{13, Stream::particle_noise};
   double s1 = 0.0, see = 0.0, soo = 0.0, seo = 0.0, s4 = 0.0;
-  for (int k = 0; k < pairs; ++k) {
-    const NormalPair z = pair_normals<SimdDraws, true>(key, 2, k, 4, 0);
+  for (const NormalPair& z : host_pair_normals<true>(key, 2, 0, pairs, 4, 0)) {
     s1 += z.z0 + z.z1;
     see += z.z0 * z.z0;
     soo += z.z1 * z.z1;

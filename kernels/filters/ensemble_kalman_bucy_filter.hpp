@@ -188,7 +188,7 @@ struct EnsembleKalmanBucyBase {
   using LaneLayout = ObservationAndProcessLayout<Stochastic ? p : 0, q>;
 
   /// Host: every ensemble member's move, host_member_chunk of them at a time in SIMD lanes: their normals first
-  /// (draw_normal_lanes: the same numbers as normal_vector, glibc's vector log, sin and cos), then the moves. The
+  /// (draw_normal_lanes: the same numbers as normal_vector, Box-Muller in SIMD lanes), then the moves. The
   /// stochastic EnKBF's scalar draws and drift (libm's log, cos, sin per ensemble member) took 62% of `kushner
   /// compare`'s default run.
   void move_in_lanes(const Model& model, const int member, const StepInput<p>& in, const Mat<n, p>& K,
@@ -196,15 +196,13 @@ struct EnsembleKalmanBucyBase {
                      const std::uint32_t who, const std::uint32_t step_index) const {
     constexpr int chunk = host_member_chunk;
     constexpr int draws = LaneLayout::normals;
-    const auto counter_of = [who, step_index](const int k, const int draw) {
-      return Counter{who, static_cast<std::uint32_t>(k), step_index, static_cast<std::uint32_t>(draw)};
-    };
     double* const xs = &ensemble(member, 0, 0);  // raw: GCC does not vectorize a loop that reloads a View's pointer
     const std::size_t k_stride = ensemble.stride(1), i_stride = ensemble.stride(2);
     for (int begin = 0; begin < num_particles; begin += chunk) {
       const int end = host_chunk_end(begin, num_particles);
       double z[draws * chunk];
-      draw_normal_lanes<draws>(begin, end, noise_key, counter_of, z, chunk);
+      const Counter first{who, static_cast<std::uint32_t>(begin), step_index, 0};
+      draw_normal_lanes<draws>(noise_key, {first, Counter{0, 1, 0, 0}}, end - begin, z, chunk);
       KUSHNER_SIMD
       for (int k = begin; k < end; ++k)
         move_lane(model, in, K, LV, h_bar, sqrt_dt, xs + k * k_stride, i_stride, z + (k - begin));

@@ -18,14 +18,7 @@ namespace kushner {
 template <bool Fp32, int K>
 inline void draw_block_normals(const RngKey& key, int member, int first_pair, int pairs, std::uint32_t step,
                                double (&z)[K][host_particle_block]) {
-  for (int i = 0; i < K; ++i) {
-    KUSHNER_SIMD
-    for (int k = 0; k < pairs; ++k) {
-      const NormalPair zk = pair_normals<SimdDraws, Fp32>(key, member, first_pair + k, step, i);
-      z[i][2 * k] = zk.z0;
-      z[i][2 * k + 1] = zk.z1;
-    }
-  }
+  for (int i = 0; i < K; ++i) draw_pair_lanes<Fp32>(key, particle_pair_lanes(member, first_pair, step, i), pairs, z[i]);
 }
 
 /// The host kernel's work for one block: a function of the model and the data only (not of the execution
@@ -74,12 +67,12 @@ KUSHNER_SAME_CODE_FOR_ALL_CALLERS void particle_block_host(const ParticleStepDat
   else
     draw_block_normals<false, K>(key, member, first_pair, pairs, step, z);
   if constexpr (draws_uniform<Model, Initialize>) {
+    double u0[B / 2], u1[B / 2];
+    simd::uniform_pair_lanes(key, particle_pair_lanes(member, first_pair, step, K), pairs, u0, u1);
     KUSHNER_SIMD
     for (int k = 0; k < pairs; ++k) {
-      double u0, u1;
-      pair_uniforms<SimdDraws>(key, member, first_pair + k, step, K, u0, u1);
-      u[2 * k] = u0;
-      u[2 * k + 1] = u1;
+      u[2 * k] = u0[k];
+      u[2 * k + 1] = u1[k];
     }
   }
   const typename Model::Control control = particle_control(d, member);

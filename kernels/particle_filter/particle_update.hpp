@@ -146,8 +146,8 @@ KOKKOS_INLINE_FUNCTION std::uint32_t particle_draw_step(const ParticleStepData<M
 }
 
 /// The draws of particles 2 pair (z0, u0) and 2 pair + 1 (z1, u1) of `member` at `step`, from Random123's Philox
-/// (the team kernels; the host kernel draws a block at a time with SimdDraws, the same bits); normals in float
-/// with `fp32` (ParticleStepData::float_normals, the same for every thread: no divergence).
+/// (the team kernels; the host kernel draws a block's lanes at once with simd::uniform_pair_lanes, the same bits);
+/// normals in float with `fp32` (ParticleStepData::float_normals, the same for every thread: no divergence).
 template <class Model, bool Initialize>
 KOKKOS_INLINE_FUNCTION void draw_particle_pair(const RngKey& key, int member, int pair, std::uint32_t step, bool fp32,
                                                Vec<particle_draw_dim<Model, Initialize>>& z0,
@@ -155,13 +155,13 @@ KOKKOS_INLINE_FUNCTION void draw_particle_pair(const RngKey& key, int member, in
   constexpr int K = particle_draw_dim<Model, Initialize>;
   KUSHNER_DEVICE_UNROLL
   for (int i = 0; i < K; ++i) {
-    const NormalPair zi = fp32 ? pair_normals<Random123Draws, true>(key, member, pair, step, i)
-                               : pair_normals<Random123Draws>(key, member, pair, step, i);
+    const NormalPair zi =
+        fp32 ? pair_normals<true>(key, member, pair, step, i) : pair_normals(key, member, pair, step, i);
     z0[i] = zi.z0;
     z1[i] = zi.z1;
   }
   u0 = u1 = 0.0;
-  if constexpr (draws_uniform<Model, Initialize>) pair_uniforms<Random123Draws>(key, member, pair, step, K, u0, u1);
+  if constexpr (draws_uniform<Model, Initialize>) pair_uniforms(key, member, pair, step, K, u0, u1);
 }
 
 /// V^{-1} dy of one member: the only observation term the likelihood needs besides h(x).
