@@ -275,6 +275,13 @@ class FilterBank {
     return names;
   }
 
+  /// Whether any of the bank's filters is selected (the outside estimators aside).
+  bool any_filter_enabled() const {
+    bool any = false;
+    for_each_filter_slot(slots_, [&](const auto& slot) { any = any || slot.enabled; });
+    return any;
+  }
+
   /// The slot of filter type Filter (one the model supports).
   template <template <class, class> class Filter>
   const FilterSlot<Filter<Model, MemSpace>, MemSpace>& slot() const {
@@ -366,9 +373,9 @@ class FilterBank {
         kept.snapshot = BankVector<MemSpace>("kushner::snapshot_kept_" + name, members_, num_snapshot_columns);
       });
     }
-    Kokkos::deep_copy(space_, kept_.truth, truths_.state());
-    Kokkos::deep_copy(space_, kept_.dy, truths_.observations());
-    Kokkos::deep_copy(space_, kept_.truth_status, truth_status_);
+    parallel_for_members("kushner::keep_truth_step", space_, members_,
+                         KeepTruthStep<MemSpace>{truths_.state(), truths_.observations(), truth_status_, kept_.truth,
+                                                 kept_.dy, kept_.truth_status});
     for_each_kept_slot([&](auto& kept, const auto& slot) {
       if (!slot.enabled) return;
       Kokkos::deep_copy(space_, kept.m, slot.m);
@@ -449,6 +456,7 @@ class FilterBank {
   }
 
   void score_reference(const typename K::Slots& slots, const ScoredTime& time, bool record) {
+    if (!any_filter_enabled()) return;  // the reference alone (`--filters PF`): a launch that would score nothing
     parallel_for_members(
         "kushner::filter_bank_reference_score", space_, members_,
         typename K::Reference{time.reference, time.reference_status, time.truth_status, slots, record});

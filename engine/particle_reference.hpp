@@ -20,16 +20,22 @@
 
 namespace kushner {
 
+/// Adds a step's ESS and trace(P) / ESS to each member's sums; a step pair's two steps in one launch, in order.
 template <int N, class MemSpace>
 struct AccumulateEss {
-  BankScalar<double, MemSpace> ess;
-  BankSymmetric<MemSpace> covariance;
+  BankScalar<double, MemSpace> ess, ess_next;  // ess_next: the second step of a pair (empty after one step)
+  BankSymmetric<MemSpace> covariance, covariance_next;
   BankVector<MemSpace> sums;  // (member, 0): sum of ESS; (member, 1): sum of trace(P) / ESS
-  KOKKOS_INLINE_FUNCTION void operator()(const int member) const {
+  KOKKOS_INLINE_FUNCTION void add(const int member, const BankScalar<double, MemSpace>& e,
+                                  const BankSymmetric<MemSpace>& p) const {
     double trace = 0.0;
-    for (int i = 0; i < N; ++i) trace += covariance(member, packed_index(N, i, i));
-    sums(member, 0) += ess(member);
-    sums(member, 1) += trace / ess(member);
+    for (int i = 0; i < N; ++i) trace += p(member, packed_index(N, i, i));
+    sums(member, 0) += e(member);
+    sums(member, 1) += trace / e(member);
+  }
+  KOKKOS_INLINE_FUNCTION void operator()(const int member) const {
+    add(member, ess, covariance);
+    if (ess_next.extent(0) > 0) add(member, ess_next, covariance_next);
   }
 };
 
@@ -68,10 +74,14 @@ class ParticleReference final : public ReferenceEstimator<typename ExecSpace::me
   const ParticleFilterBank<ExecSpace, Model, Real>& bank() const { return pf_; }
 
  private:
-  void accumulate_ess(const BankScalar<double, MemSpace>& ess, const BankSymmetric<MemSpace>& covariance) {
-    parallel_for_members("kushner::accumulate_ess", space_, pf_.num_members(),
-                         AccumulateEss<Model::state_dim, MemSpace>{ess, covariance, sums_});
-    ++steps_;
+  /// The steps just taken: one, or a pair's two (`pair`).
+  void accumulate_ess(const bool pair) {
+    using Accumulate = AccumulateEss<Model::state_dim, MemSpace>;
+    const Accumulate one{pf_.effective_sample_size(), {}, pf_.posterior_covariance(), {}, sums_};
+    const Accumulate two{pf_.first_step().ess, pf_.effective_sample_size(), pf_.first_step().covariance,
+                         pf_.posterior_covariance(), sums_};
+    parallel_for_members("kushner::accumulate_ess", space_, pf_.num_members(), pair ? two : one);
+    steps_ += pair ? 2 : 1;
   }
 
   ExecSpace space_;
@@ -84,15 +94,14 @@ class ParticleReference final : public ReferenceEstimator<typename ExecSpace::me
 template <class ExecSpace, class Model, class Real>
 void ParticleReference<ExecSpace, Model, Real>::advance(long k, double, double dt, const BankVector<MemSpace>& dy) {
   pf_.step(k, dt, dy);
-  accumulate_ess(pf_.effective_sample_size(), pf_.posterior_covariance());
+  accumulate_ess(false);
 }
 
 template <class ExecSpace, class Model, class Real>
 void ParticleReference<ExecSpace, Model, Real>::advance_pair(long k, double, double dt, const BankVector<MemSpace>& dy,
                                                              const BankVector<MemSpace>& dy_next) {
   pf_.step_pair(k, dt, dy, dy_next);
-  accumulate_ess(pf_.first_step().ess, pf_.first_step().covariance);
-  accumulate_ess(pf_.effective_sample_size(), pf_.posterior_covariance());
+  accumulate_ess(true);
 }
 
 template <class ExecSpace, class Model, class Real>

@@ -86,6 +86,14 @@ struct MemberChunks {
   }
 };
 
+/// Whether a GPU member kernel's functor goes to the device as its launch's parameters (Kokkos' light-weight
+/// launch; CUDA's parameters hold 4 KB, the launch adds its policy). Kokkos copies a functor of more than 512 bytes
+/// to constant memory otherwise, and such a launch first waits for the kernel of the one before it: the bank's step
+/// and reference scores (3.1-3.3 KB for sine) stopped the host behind the particle filter's pass at every step,
+/// and the device then sat idle while the host launched the next step's kernels (perf/particle_filter.md).
+template <class Functor>
+constexpr bool member_functor_in_parameters = sizeof(Functor) + 256 <= 4096;
+
 /// f(member) for member in [0, members). No fence.
 template <class ExecSpace, class Functor>
 void parallel_for_members(const std::string& name, const ExecSpace& space, long members, const Functor& f) {
@@ -94,6 +102,9 @@ void parallel_for_members(const std::string& name, const ExecSpace& space, long 
     Kokkos::parallel_for(name,
                          Kokkos::RangePolicy<ExecSpace>(space, 0, (m + host_member_chunk - 1) / host_member_chunk),
                          MemberChunks<Functor>{f, m});
+  } else if constexpr (member_functor_in_parameters<Functor>) {
+    using LightWeight = Kokkos::Experimental::WorkItemProperty::HintLightWeight_t;
+    Kokkos::parallel_for(name, Kokkos::RangePolicy<ExecSpace, LightWeight>(space, 0, m), f);
   } else {
     Kokkos::parallel_for(name, Kokkos::RangePolicy<ExecSpace>(space, 0, m), f);
   }

@@ -1,12 +1,18 @@
 // A minimal Kokkos Tools library: wall time per kernel name and per deep_copy direction, printed at exit, for
 // finding where a run's time goes where no profiler is installed (the GPU machine has no Nsight Systems).
-// With CUDA_LAUNCH_BLOCKING=1 every kernel ends before its launch returns, so its begin-to-end time is its
-// execution time; the time outside kernels and copies is host work and waiting.
+// Kokkos fences the device after every kernel while a tool is loaded (unless the tool asks it not to), so a kernel's
+// begin-to-end time is its launch and execution; the time outside kernels and copies is host work.
 //   g++ -O2 -shared -fPIC perf/kokkos_kernel_timer.cpp -o kernel_timer.so
-//   CUDA_LAUNCH_BLOCKING=1 KOKKOS_PROFILE_LIBRARY=./kernel_timer.so kushner filter ...      (report on stderr)
+//   KOKKOS_PROFILE_LIBRARY=./kernel_timer.so kushner filter ...      (report on stderr)
+// KERNEL_TIMER_ASYNC=1 asks Kokkos for no fences: a kernel's time is then its launch's, how long the host spent in
+// the call, and a launch that waits for the device stands out (Kokkos' constant-memory launches, of functors over
+// 512 bytes, wait for the kernel of the one before).
+// KERNEL_TIMER_TRACE=FIRST:COUNT also lists the events FIRST to FIRST + COUNT - 1 in the order they began, each with
+// its begin and end in microseconds since the first listed one: what the host did between two launches.
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <string>
 #include <vector>
@@ -14,6 +20,23 @@
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+struct Event {
+  std::string name;
+  double begin_us, end_us;
+};
+
+struct Trace {
+  long first = -1, count = 0;  // the events listed
+  long seen = 0;               // events begun so far
+  Clock::time_point origin;
+  std::vector<Event> events;
+};
+
+Trace& trace() {
+  static Trace t;
+  return t;
+}
 
 struct Total {
   long calls = 0;
@@ -24,26 +47,45 @@ std::map<std::string, Total>& totals() {
   static std::map<std::string, Total> t;
   return t;
 }
-std::vector<std::pair<std::string, Clock::time_point>>& open_regions() {
-  static std::vector<std::pair<std::string, Clock::time_point>> o;
-  return o;
-}
 Clock::time_point& library_start() {
   static Clock::time_point s;
   return s;
 }
 
+struct Open {
+  std::string name;
+  Clock::time_point start;
+  long traced;  // index in trace().events, or -1
+};
+
+std::vector<Open>& open_events() {
+  static std::vector<Open> o;
+  return o;
+}
+
 void begin(const std::string& name, std::uint64_t* id) {
-  open_regions().emplace_back(name, Clock::now());
-  if (id) *id = open_regions().size() - 1;
+  const Clock::time_point now = Clock::now();
+  Trace& t = trace();
+  long traced = -1;
+  const long index = t.seen++;
+  if (t.first >= 0 && index >= t.first && index < t.first + t.count) {
+    if (t.events.empty()) t.origin = now;
+    traced = static_cast<long>(t.events.size());
+    t.events.push_back({name, std::chrono::duration<double, std::micro>(now - t.origin).count(), 0.0});
+  }
+  open_events().push_back({name, now, traced});
+  if (id) *id = open_events().size() - 1;
 }
 void end() {
-  if (open_regions().empty()) return;
-  const auto [name, start] = open_regions().back();
-  open_regions().pop_back();
-  Total& t = totals()[name];
+  if (open_events().empty()) return;
+  const Open o = open_events().back();
+  open_events().pop_back();
+  const Clock::time_point now = Clock::now();
+  Total& t = totals()[o.name];
   ++t.calls;
-  t.seconds += std::chrono::duration<double>(Clock::now() - start).count();
+  t.seconds += std::chrono::duration<double>(now - o.start).count();
+  if (o.traced >= 0)
+    trace().events[o.traced].end_us = std::chrono::duration<double, std::micro>(now - trace().origin).count();
 }
 
 }  // namespace
@@ -52,9 +94,26 @@ struct SpaceHandle {
   char name[64];
 };
 
+struct ToolSettings {  // Kokkos_Tools_ToolSettings (impl/Kokkos_Profiling_C_Interface.h)
+  bool requires_global_fencing;
+  bool padding[255];
+};
+
 extern "C" {
 
-void kokkosp_init_library(int, std::uint64_t, std::uint32_t, void*) { library_start() = Clock::now(); }
+void kokkosp_init_library(int, std::uint64_t, std::uint32_t, void*) {
+  library_start() = Clock::now();
+  if (const char* spec = std::getenv("KERNEL_TIMER_TRACE")) {
+    char* rest = nullptr;
+    trace().first = std::strtol(spec, &rest, 10);
+    trace().count = *rest == ':' ? std::strtol(rest + 1, nullptr, 10) : 100;
+  }
+}
+
+void kokkosp_request_tool_settings(const std::uint32_t, ToolSettings* settings) {
+  const char* async = std::getenv("KERNEL_TIMER_ASYNC");
+  settings->requires_global_fencing = !(async && async[0] == '1');
+}
 
 void kokkosp_finalize_library() {
   const double wall = std::chrono::duration<double>(Clock::now() - library_start()).count();
@@ -66,6 +125,9 @@ void kokkosp_finalize_library() {
     std::fprintf(stderr, "%12.4f %8ld %12.1f  %s\n", t.seconds, t.calls, 1e6 * t.seconds / t.calls, name.c_str());
   }
   std::fprintf(stderr, "%12.4f %8s %12s  %s\n", wall - counted, "", "", "(outside kernels and copies)");
+  if (!trace().events.empty()) std::fprintf(stderr, "%10s %10s %9s  %s\n", "begin us", "end us", "took us", "event");
+  for (const Event& e : trace().events)
+    std::fprintf(stderr, "%10.1f %10.1f %9.1f  %s\n", e.begin_us, e.end_us, e.end_us - e.begin_us, e.name.c_str());
 }
 
 void kokkosp_begin_parallel_for(const char* name, std::uint32_t, std::uint64_t* id) { begin(name, id); }

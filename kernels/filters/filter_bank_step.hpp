@@ -202,6 +202,22 @@ struct FilterBankInitialScore {
   }
 };
 
+/// A step pair's copy of its first step's truths, increments and truth statuses (FilterBank::keep_step), in one
+/// launch rather than three copies.
+template <class MemSpace>
+struct KeepTruthStep {
+  BankVector<MemSpace> truth, dy;
+  BankScalar<Status, MemSpace> truth_status;
+  BankVector<MemSpace> kept_truth, kept_dy;
+  BankScalar<Status, MemSpace> kept_truth_status;
+
+  KOKKOS_INLINE_FUNCTION void operator()(const int member) const {
+    for (int i = 0; i < static_cast<int>(truth.extent(1)); ++i) kept_truth(member, i) = truth(member, i);
+    for (int i = 0; i < static_cast<int>(dy.extent(1)); ++i) kept_dy(member, i) = dy(member, i);
+    kept_truth_status(member) = truth_status(member);
+  }
+};
+
 /// After a reference (e.g. a particle filter) has taken the same step: |m - m_ref|^2 for every filter, on the
 /// members whose truth and reference are both still ok (a diverged reference's frozen mean is no reference).
 template <class Model, class MemSpace, class ReferenceView, class... Filters>
