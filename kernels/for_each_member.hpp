@@ -89,8 +89,8 @@ struct MemberChunks {
 /// Whether a GPU member kernel's functor goes to the device as its launch's parameters (Kokkos' light-weight
 /// launch; CUDA's parameters hold 4 KB, the launch adds its policy). Kokkos copies a functor of more than 512 bytes
 /// to constant memory otherwise, and such a launch first waits for the kernel of the one before it: the bank's step
-/// and reference scores (3.1-3.3 KB for sine) stopped the host behind the particle filter's pass at every step,
-/// and the device then sat idle while the host launched the next step's kernels (perf/particle_filter.md).
+/// and reference scores (3.1-3.3 KB for sine) stopped the host behind the particle filter's pass at every step pair,
+/// and the device then sat idle while the host launched the next pair's kernels (perf/particle_filter.md).
 template <class Functor>
 constexpr bool member_functor_in_parameters = sizeof(Functor) + 256 <= 4096;
 
