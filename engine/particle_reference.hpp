@@ -77,10 +77,11 @@ class ParticleReference final : public ReferenceEstimator<typename ExecSpace::me
   /// The steps just taken: one, or a pair's two (`pair`).
   void accumulate_ess(const bool pair) {
     using Accumulate = AccumulateEss<Model::state_dim, MemSpace>;
-    const Accumulate one{pf_.effective_sample_size(), {}, pf_.posterior_covariance(), {}, sums_};
-    const Accumulate two{pf_.first_step().ess, pf_.effective_sample_size(), pf_.first_step().covariance,
-                         pf_.posterior_covariance(), sums_};
-    parallel_for_members("kushner::accumulate_ess", space_, pf_.num_members(), pair ? two : one);
+    const Accumulate accumulate =
+        pair ? Accumulate{pf_.first_step().ess, pf_.effective_sample_size(), pf_.first_step().covariance,
+                          pf_.posterior_covariance(), sums_}
+             : Accumulate{pf_.effective_sample_size(), {}, pf_.posterior_covariance(), {}, sums_};
+    parallel_for_members("kushner::accumulate_ess", space_, pf_.num_members(), accumulate);
     steps_ += pair ? 2 : 1;
   }
 
