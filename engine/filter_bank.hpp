@@ -502,25 +502,26 @@ class FilterBank {
   struct SnapshotBuffers {
     ColumnMoments<ExecSpace> moments;
     DivergedMembers<MemSpace> diverged;
-    const void* slots = nullptr;  // the slots whose columns they reduced last: taken again for the same slots
+    const void* slots = nullptr;  // the slots whose columns they reduce (the bank's own or the kept ones)
   };
   struct PendingSnapshots {
     std::vector<std::string> names;
     std::vector<int> first;  // names[i]'s first column in buffers->moments
     SnapshotBuffers* buffers = nullptr;
   };
-  /// Buffers free of pending snapshots, for the columns of `slots`: the same addresses as the last time where a
-  /// free set last reduced them.
+  /// Buffers free of pending snapshots that reduced the columns of `slots` before, or new ones: a set serves one
+  /// `slots` for good. Step pairs' output times reduce the kept slots and the bank's own by turns, and a set taken
+  /// over from the other kind uploaded its column addresses anew, each upload a wait for the device (a full queue
+  /// drained at every output time, the device then idle while the host launched the next pair).
   SnapshotBuffers& free_snapshot_buffers(const void* slots) const {
-    SnapshotBuffers* free = nullptr;
     for (const auto& buffers : snapshot_buffers_) {
       const bool in_use = std::any_of(pending_.begin(), pending_.end(),
                                       [&](const PendingSnapshots& p) { return p.buffers == buffers.get(); });
-      if (!in_use && (free == nullptr || buffers->slots == slots)) free = buffers.get();
+      if (!in_use && buffers->slots == slots) return *buffers;
     }
-    if (free == nullptr) free = snapshot_buffers_.emplace_back(std::make_unique<SnapshotBuffers>()).get();
-    free->slots = slots;
-    return *free;
+    SnapshotBuffers& created = *snapshot_buffers_.emplace_back(std::make_unique<SnapshotBuffers>());
+    created.slots = slots;
+    return created;
   }
   mutable std::vector<std::unique_ptr<SnapshotBuffers>> snapshot_buffers_;
   // Oldest first; at most three where every step ends at an output time and pairs start one in their middle.

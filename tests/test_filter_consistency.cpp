@@ -3,7 +3,7 @@
 // the exact Kalman filter of the Euler-Maruyama truths, so E[NEES] = n at every time, not just as dt -> 0).
 // Power: a filter that assumes half the process noise intensity must fail the same test.
 // Step pairs (FilterBank::step_pair: the bank scores one step behind so that the particle filter takes two steps per
-// call) give the numbers of single steps.
+// call) give the numbers of single steps, and their output times keep their reductions' buffers.
 #include "engine/filter_run.hpp"
 #include "kernels/filters/filter_list.hpp"
 #include "models/linear_model.hpp"
@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <string>
 
@@ -120,6 +121,31 @@ TEST(StepPairs, ScoringOneStepBehindGivesTheNumbersOfSingleSteps) {
     EXPECT_EQ(step_pairs_field(team_fused), "fused");
     expect_same_report(team_single, team_fused, 1e-10);
   }
+}
+
+/// Allocations of the device copies of output reductions' column addresses (kernels/device_addresses.hpp): on a GPU
+/// each one waits for the device (a copy from a host vector and a fence), and the host then launches the next kernels
+/// onto an idle device.
+long address_uploads = 0;
+void count_address_uploads(const Kokkos::Tools::SpaceHandle, const char* label, const void*, const std::uint64_t) {
+  if (std::strcmp(label, "kushner::device_addresses") == 0) ++address_uploads;
+}
+
+TEST(StepPairs, OutputTimesKeepTheirReductionsAddresses) {
+  // An output time every 5th step falls in a pair's middle (the kept snapshot columns and statuses are reduced) and
+  // at a pair's end (the bank's own) by turns: each kind of output time must find the buffers that reduced it last
+  // time, so the uploads are as many for 30 output times as for 10.
+  const auto uploads = [](double T) {
+    address_uploads = 0;
+    Kokkos::Tools::Experimental::set_allocate_data_callback(count_address_uploads);
+    run_with_pairs(StepPairs::always, ParticleKernel::automatic,
+                   make_time_grid(T, 0.01, static_cast<int>(std::lround(T / 0.05))));
+    Kokkos::Tools::Experimental::set_allocate_data_callback(nullptr);
+    return address_uploads;
+  };
+  const long ten_outputs = uploads(0.5), thirty_outputs = uploads(1.5);
+  EXPECT_GT(ten_outputs, 0);
+  EXPECT_EQ(thirty_outputs, ten_outputs);
 }
 
 }  // namespace
