@@ -234,7 +234,8 @@ class ParticleFilterBank {
   void run_step_kernels(const ParticleStepData<Model, MemSpace, Real>& d) {
     constexpr int n = state_dim;
     if (use_team_) {
-      run_team_kernel(ParticleTeamStep<Model, ExecSpace, Real>{d});
+      with_team_arithmetic(
+          [&](auto mixed) { run_team_kernel(ParticleTeamStep<Model, ExecSpace, Real, decltype(mixed)::value>{d}); });
     } else {
       run_host_block_kernel(d);
     }
@@ -305,6 +306,19 @@ class ParticleFilterBank {
               BankScalar<double, MemSpace>("kushner::ess_first", num_members_),
               BankScalar<Status, MemSpace>("kushner::particle_status_first", num_members_)};
     first_log_normalizer_ = BankScalar<double, MemSpace>("kushner::log_normalizer_first", num_members_);
+  }
+
+  /// f(std::bool_constant<Mixed>()) with the team kernels' Mixed: true for the mixed precision where the model has
+  /// float increments (those kernels of its own), else false (fp64's kernels, and mixed's normals as a run-time flag).
+  template <class F>
+  void with_team_arithmetic(F&& f) {
+    if constexpr (std::is_same_v<Real, double> && has_float_increments<Model>) {
+      if (options_.precision == ParticlePrecision::mixed) {
+        f(std::true_type());
+        return;
+      }
+    }
+    f(std::false_type());
   }
 
   /// A team kernel (ParticleTeamStep, ParticleTeamPairStep) over every (chunk, member), a team each.
@@ -480,7 +494,10 @@ void ParticleFilterBank<ExecSpace, Model, Real>::step_pair(long k, double dt, co
   const auto first = static_cast<std::uint32_t>(k), second = first + 1;
   const ParticleSecondStep<Model, MemSpace, Real> next{
       x_next_, log_weight_next_, dy_next, partials_next_, observation_precision((k + 1) * dt), (k + 1) * dt};
-  run_team_kernel(ParticleTeamPairStep<Model, ExecSpace, Real>{step_data(k * dt, dt, first, dy), next});
+  with_team_arithmetic([&](auto mixed) {
+    run_team_kernel(
+        ParticleTeamPairStep<Model, ExecSpace, Real, decltype(mixed)::value>{step_data(k * dt, dt, first, dy), next});
+  });
   // The pass's output becomes the bank; its input (step k - 1's particles) stays for the redo.
   std::swap(x_, x_next_);
   std::swap(workspace_.cumulative, log_weight_next_);
@@ -495,12 +512,17 @@ void ParticleFilterBank<ExecSpace, Model, Real>::step_pair(long k, double dt, co
       space_, CopyListedMembers<state_dim, MemSpace, Real>{
                   x_next_, x_, log_weight_next_, workspace_.cumulative, resample_list_, resample_list_size_,
                   num_particles_, copy_items < listed_copy_items ? copy_items : listed_copy_items});
-  run_team_kernel_listed(ParticleTeamStep<Model, ExecSpace, Real>{step_data(k * dt, dt, first, dy)});
+  with_team_arithmetic([&](auto mixed) {
+    run_team_kernel_listed(
+        ParticleTeamStep<Model, ExecSpace, Real, decltype(mixed)::value>{step_data(k * dt, dt, first, dy)});
+  });
   resample_listed(first_log_normalizer_, first);
   ParticleStepData<Model, MemSpace, Real> redo = step_data((k + 1) * dt, dt, second, dy_next);
   redo.log_normalizer = first_log_normalizer_;  // log N after the resampling
   redo.partials = partials_next_;
-  run_team_kernel_listed(ParticleTeamStep<Model, ExecSpace, Real>{redo});
+  with_team_arithmetic([&](auto mixed) {
+    run_team_kernel_listed(ParticleTeamStep<Model, ExecSpace, Real, decltype(mixed)::value>{redo});
+  });
   // Step k + 1's posterior and resampling, as in step().
   Kokkos::deep_copy(space_, resample_list_size_, 0);
   run_posterior(partials_next_, current_posterior(), log_normalizer_, true);

@@ -2,6 +2,7 @@
 // staying isolated, and the GPU's team kernel (run here on the host) against the host's SIMD block kernel.
 #include "engine/particle_filter_bank.hpp"
 #include "engine/truth_bank.hpp"
+#include "models/benes_model.hpp"
 #include "models/cubic_oscillator_model.hpp"
 #include "models/sine_model.hpp"
 #include "tests/test_spaces.hpp"
@@ -265,19 +266,21 @@ TEST(ParticleFilterBank, TeamKernelResumsWhenTheWeightBoundIsFarOff) {
   });
 }
 
-TEST(ParticleFilterBank, Fp32TeamKernelResumsWhereFloatExpUnderflows) {
-  // Under fp32 the team kernel takes exp(l - s) in float, whose normal numbers end near e^-87. A dy that puts the
-  // bound s about 100 nats above every particle's l (inside fp64's 200-nat gap, past float's range) must make the
-  // team sum again relative to its largest l, and give the host kernel's posterior (block maxima, exp in double):
-  // the same particles up to a float's last bits, so to 1e-5. Also for step_pair, the outlier in each of its steps.
+/// Under fp32 and mixed (for sine: its kernels of its own) the team kernel takes exp(l - s) in float, whose normal
+/// numbers end near e^-87. A dy that puts the bound s about 100 nats above every particle's l (inside fp64's 200-nat
+/// gap, past float's range) must make the team sum again relative to its largest l, and give the host kernel's
+/// posterior (block maxima, exp in double): the same particles up to a float's last bits, so to 1e-5. Also for
+/// step_pair, the outlier in each of its steps.
+template <class Real>
+void expect_float_exp_team_kernel_resums(ParticlePrecision precision) {
   SineModel model;
   const int members = 3, particles = 3000;
   ParticleFilterOptions block, team;
   block.kernel = ParticleKernel::host_block;
   team.kernel = ParticleKernel::team;
-  block.precision = team.precision = ParticlePrecision::fp32;
+  block.precision = team.precision = precision;
   block.ess_threshold = team.ess_threshold = 0.0;
-  using Bank = ParticleFilterBank<Host, SineModel, float>;
+  using Bank = ParticleFilterBank<Host, SineModel, Real>;
   Bank pb(Host(), model, members, particles, seed, block);
   Bank pt(Host(), model, members, particles, seed, team);
   Bank pp(Host(), model, members, particles, seed, team);
@@ -303,6 +306,11 @@ TEST(ParticleFilterBank, Fp32TeamKernelResumsWhereFloatExpUnderflows) {
     expect_agree(pt, "step", k);
     if (k % 2 == 0) expect_agree(pp, "step_pair", k);
   });
+}
+
+TEST(ParticleFilterBank, FloatExpTeamKernelsResumWhereItUnderflows) {
+  expect_float_exp_team_kernel_resums<float>(ParticlePrecision::fp32);
+  expect_float_exp_team_kernel_resums<double>(ParticlePrecision::mixed);
 }
 
 /// Posterior mean, covariance and ESS of every member, and the resampling counts.
@@ -337,8 +345,9 @@ TEST(ParticleFilterBank, MixedAndFp32TeamKernelAgreesWithHostBlockKernel) {
   // kernel takes the weights' exp in float: weights that differ by 1e-7 move a systematic point across a particle now
   // and then, which moves the mean by about a particle's distance over N (measured 3.0e-4). Against the finer
   // precision (mixed against fp64, fp32 against mixed) they differ, but by less than 10 particles' distance over N:
-  // mixed by its normals' rounding (measured 1.6e-7), fp32 by the few systematic points that its float cumulative
-  // weights put on the other side of a particle (measured 1.8e-3, against a Monte Carlo error near 2e-2).
+  // mixed by its normals' and float increments' rounding, which here moved a systematic point across a particle
+  // (measured 2.4e-5; 1.6e-7 when only the normals were floats), fp32 by the few systematic points that its float
+  // cumulative weights put on the other side of a particle (measured 1.8e-3, against a Monte Carlo error near 2e-2).
   for (auto precision : {ParticlePrecision::mixed, ParticlePrecision::fp32}) {
     ParticleFilterOptions block, team;
     block.kernel = ParticleKernel::host_block;
@@ -411,15 +420,17 @@ TEST(ParticleFilterBank, Fp32StoresFloatsAndItsPosteriorIsTheirs) {
   EXPECT_EQ(Fp64::bytes_per_particle(fp32) - sizeof(int), (Fp64::bytes_per_particle(mixed) - sizeof(int)) / 2);
 }
 
-/// update_particle's step of one particle from x with normals z, in a bank that stores Real.
-template <class Model, class Real>
+/// update_particle's step of one particle from x with normals z, in a bank that stores Real; with FloatIncrements as
+/// mixed's kernels take it.
+template <class Model, class Real, bool FloatIncrements = false>
 double step_one_particle(const Model& model, const Vec<Model::noise_dim>& z, Vec<Model::state_dim>& x) {
   ParticleStepData<Model, Kokkos::HostSpace, Real> d;
   d.model = model;
   d.set_step_length(0.01);
   Mat<Model::obs_dim, Model::obs_dim> precision = Mat<Model::obs_dim, Model::obs_dim>::diagonal(4.0);
   const Vec<Model::obs_dim> vinv_dy = Vec<Model::obs_dim>::constant(0.013);
-  return update_particle<false>(d, 0.0, precision, z, 0.0, -7.25, 0.125, vinv_dy, Model::Control::zero(), x);
+  return update_particle<false, FloatIncrements>(d, 0.0, precision, z, 0.0, -7.25, 0.125, vinv_dy,
+                                                 Model::Control::zero(), x);
 }
 
 TEST(ParticleFilterBank, Fp32StepsInFloatWhereTheModelTakesFloat) {
@@ -456,6 +467,53 @@ TEST(ParticleFilterBank, Fp32StepsInFloatWhereTheModelTakesFloat) {
   std::cout << "sine: fp32 step differs from the rounded fp64 step for " << sine_rounded_differently
             << " of 2000 particles\n";
   EXPECT_GT(sine_rounded_differently, 100);
+}
+
+TEST(ParticleFilterBank, MixedTakesFloatIncrementsOfADoubleState) {
+  // mixed computes a particle's Euler-Maruyama increment f dt + G sqrt(dt) z in float where the model's dynamics take
+  // float (cheaper on a GPU) and adds it to the state in double: the state is not rounded to float, the increment is
+  // (to a few float ulps of itself against the expression written out here, and within those and the drift's change
+  // over x's float rounding of fp64's step), and the log-weight is the fp64 one of the new state. Elsewhere (the cubic
+  // oscillator: double-only dynamics) mixed steps as fp64 does.
+  static_assert(has_float_increments<SineModel> && !has_float_increments<CubicOscillatorModel>);
+  static_assert(!has_float_increments<BenesModel>);  // an exact transition: no Euler-Maruyama increment
+  SineModel sine;
+  int state_not_a_float = 0, increment_rounded = 0;
+  for (int k = 0; k < 2000; ++k) {
+    const double x0 = -3.0 + 6.0 * (k + 0.5) / 2000 + 1e-9 * k, z = std::sin(1e3 * k);
+    Vec<1> xm{{x0}}, xd{{x0}};
+    const double lm = step_one_particle<SineModel, double, true>(sine, Vec<1>{{z}}, xm);
+    const double ld = step_one_particle<SineModel, double>(sine, Vec<1>{{z}}, xd);
+    const float xf = static_cast<float>(x0);
+    const float dx = (-std::sin(xf)) * 0.01f + static_cast<float>(sine.q) * (static_cast<float>(z) * std::sqrt(0.01f));
+    ASSERT_NEAR(xm[0] - x0, dx, 4e-7 * std::abs(dx) + 1e-15) << x0;
+    // A few float ulps of the increment's two terms, and the drift at x0 rounded to float: |f'| <= 1 times 2^-24 |x0|,
+    // over dt = 0.01.
+    const double terms = std::abs(std::sin(x0)) * 0.01 + sine.q * std::abs(z) * 0.1;
+    ASSERT_NEAR(xm[0], xd[0], 4e-7 * terms + 6e-8 * std::abs(x0) * 0.01 + 1e-15) << x0;
+    Vec<1> xl = xm;  // the fp64 log-weight of the mixed state
+    const double l1 = -7.25 - 0.125 + (xl[0] * 0.013 - 0.005 * (xl[0] * (4.0 * xl[0])));
+    ASSERT_NEAR(lm, l1, 1e-14 * std::abs(l1)) << x0;
+    state_not_a_float += xm[0] != static_cast<double>(static_cast<float>(xm[0]));
+    increment_rounded += xm[0] != xd[0];
+  }
+  std::cout << "sine: mixed's state is not a float for " << state_not_a_float << " of 2000 particles, its step differs"
+            << " from fp64's for " << increment_rounded << "\n";
+  EXPECT_GT(state_not_a_float, 1900);
+  EXPECT_GT(increment_rounded, 1000);
+  // The bank takes float increments for mixed only: fp64 and fp32 as before, and mixed's kernels only for a model with
+  // float increments.
+  ParticleStepData<SineModel, Kokkos::HostSpace, double> d;
+  d.fp32_normals = true;
+  EXPECT_TRUE(d.float_increments());
+  d.fp32_normals = false;
+  EXPECT_FALSE(d.float_increments());
+  ParticleStepData<SineModel, Kokkos::HostSpace, float> f;
+  f.fp32_normals = true;
+  EXPECT_FALSE(f.float_increments());
+  ParticleStepData<CubicOscillatorModel, Kokkos::HostSpace, double> c;
+  c.fp32_normals = true;
+  EXPECT_FALSE(c.float_increments());
 }
 
 TEST(ParticleFilterBank, StepPairMatchesTwoSteps) {

@@ -23,7 +23,7 @@ inline void draw_block_normals(const RngKey& key, int member, int first_pair, in
 
 /// The host kernel's work for one block: a function of the model and the data only (not of the execution
 /// space), so Serial and OpenMP run the same machine code and give the same bits (kernels/for_each_member.hpp).
-template <bool Initialize, class Model, class Real>
+template <bool Initialize, bool FloatIncrements, class Model, class Real>
 KUSHNER_SAME_CODE_FOR_ALL_CALLERS void particle_block_host(const ParticleStepData<Model, Kokkos::HostSpace, Real>& d,
                                                            int member, int block) {
   constexpr int n = Model::state_dim;
@@ -85,8 +85,8 @@ KUSHNER_SAME_CODE_FOR_ALL_CALLERS void particle_block_host(const ParticleStepDat
     KUSHNER_UNROLL_FULLY
     for (int i = 0; i < K; ++i) zj[i] = z[i][j];
     const double uj = draws_uniform<Model, Initialize> ? u[j] : 0.0;
-    const double lj = detail::update_particle_unrounded<Initialize>(d, d.t, d.observation_precision.value, zj, uj,
-                                                                    lw[j], log_normalizer, vinv_dy, control, xj);
+    const double lj = detail::update_particle_unrounded<Initialize, FloatIncrements>(
+        d, d.t, d.observation_precision.value, zj, uj, lw[j], log_normalizer, vinv_dy, control, xj);
     KUSHNER_UNROLL_FULLY
     for (int i = 0; i < n; ++i) xs[i][j] = xj[i];
     lw[j] = lj;
@@ -171,10 +171,17 @@ struct ParticleBlockStep {
       WeightedMoments<Model::state_dim>::empty().store(d.partials, block, member);
       return;
     }
-    if (d.initialize)
-      particle_block_host<true>(d, member, block);
-    else
-      particle_block_host<false>(d, member, block);
+    if (d.initialize) {
+      particle_block_host<true, false>(d, member, block);
+      return;
+    }
+    if constexpr (std::is_same_v<Real, double> && has_float_increments<Model>) {  // `mixed`: a loop of its own
+      if (d.float_increments()) {
+        particle_block_host<false, true>(d, member, block);
+        return;
+      }
+    }
+    particle_block_host<false, false>(d, member, block);
   }
 };
 

@@ -37,12 +37,17 @@ struct has_float_dynamics<
                                                0.0, std::declval<const Vec<Model::state_dim, float>&>())),
                                            Vec<Model::obs_dim, float>>>> : std::true_type {};
 
+/// Whether a model's particles take Euler-Maruyama steps (not an exact or discrete-time transition) whose increments
+/// can be computed in float: the fp32 precision's particles then step in float, the mixed precision's take float
+/// increments of a double state.
+template <class Model>
+constexpr bool has_float_increments =
+    !Model::discrete_time && !has_exact_transition<Model>::value && has_float_dynamics<Model>::value;
+
 /// The scalar a particle's Euler-Maruyama step is computed in, for particles stored as Real: float where they are
-/// stored in float and the model's dynamics take float, else double (as are exact and discrete-time transitions).
+/// stored in float and the model has float increments, else double (as are exact and discrete-time transitions).
 template <class Model, class Real>
 using particle_step_scalar =
-    std::conditional_t<std::is_same_v<Real, float> && !Model::discrete_time && !has_exact_transition<Model>::value &&
-                           has_float_dynamics<Model>::value,
-                       float, double>;
+    std::conditional_t<std::is_same_v<Real, float> && has_float_increments<Model>, float, double>;
 
 }  // namespace kushner

@@ -11,17 +11,15 @@
 
 #include <Kokkos_Core.hpp>
 
-#include <type_traits>
-
 namespace kushner {
 
 /// Where the team's sums are too far from their shift (particles far from the observation, an extreme dy)
 /// they could under- or overflow. Within 200 of the shift a square is at most e^400 ~ 5e173, so sums of
-/// squares of any int-counted number of particles stay finite. With Real = float (fp32) the exp is taken in float
-/// (add_shifted_particle), whose normal numbers span e^-87 .. e^88: within 60 of the shift, every particle within
-/// e^-27 of the largest weight is a normal float.
-template <class Real>
-constexpr double team_max_shift_gap = std::is_same_v<Real, float> ? 60.0 : 200.0;
+/// squares of any int-counted number of particles stay finite. Where the exp is taken in float (FloatExp: fp32's and
+/// mixed's kernels, add_shifted_particle), whose normal numbers span e^-87 .. e^88: within 60 of the shift, every
+/// particle within e^-27 of the largest weight is a normal float.
+template <bool FloatExp>
+constexpr double team_max_shift_gap = FloatExp ? 60.0 : 200.0;
 
 /// Particle pairs per batch of a thread.
 constexpr int device_pairs_per_batch = (device_particle_batch + 1) / 2;
@@ -73,11 +71,12 @@ KOKKOS_INLINE_FUNCTION void draw_particle_batch(const RngKey& key, int member, i
                                           u[2 * b + 1]);
 }
 
-/// Adds a particle of log-weight l - shift; weight zero adds nothing (its x may not be finite). Its weight's exp
-/// is taken in Real (float for fp32: a GPU's fp64 exp costs several times the energy), the sums in double.
-template <class Real, int N>
+/// Adds a particle of log-weight l - shift; weight zero adds nothing (its x may not be finite). Its weight's exp is
+/// taken in float with FloatExp (the fp32 and mixed kernels: a GPU's fp64 exp costs several times the energy of its
+/// float one), the sums in double.
+template <bool FloatExp, int N>
 KOKKOS_INLINE_FUNCTION void add_shifted_particle(double shifted, const Vec<N>& dx, WeightedMoments<N>& w) {
-  const double e = math::exp(static_cast<Real>(shifted));
+  const double e = FloatExp ? static_cast<double>(math::exp(static_cast<float>(shifted))) : math::exp(shifted);
   if (e > 0.0) w.add_weight(e, dx);
 }
 
@@ -85,13 +84,14 @@ KOKKOS_INLINE_FUNCTION void add_shifted_particle(double shifted, const Vec<N>& d
 /// largest l. Afterwards every thread holds the team's sums relative to the returned shift in w. Where the
 /// team's largest l is more than team_max_shift_gap from `shift` (rare, and the same for the whole team), the
 /// team sums again relative to its largest l: resum(shift, w) adds the thread's particles to an empty w.
-template <class Real, int N, class Team, class Scratch, class Resum>
+template <bool FloatExp, int N, class Team, class Scratch, class Resum>
 KOKKOS_INLINE_FUNCTION void team_moments_at_shift(const Team& team, const Scratch& buffer, double shift,
                                                   WeightedMoments<N>& w, const Resum& resum) {
   team_sum(team, buffer, w);
   if (!(w.max_log_weight > -math::infinity())) return;  // every particle of the chunk has weight zero
   const double gap = w.max_log_weight - shift;
-  if (!(gap >= -team_max_shift_gap<Real> && gap <= team_max_shift_gap<Real>)) {
+  constexpr double max_gap = team_max_shift_gap<FloatExp>;
+  if (!(gap >= -max_gap && gap <= max_gap)) {
     shift = w.max_log_weight;
     w = WeightedMoments<N>::empty();
     resum(shift, w);

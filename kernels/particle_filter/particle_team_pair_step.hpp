@@ -10,20 +10,29 @@
 
 #include <Kokkos_Core.hpp>
 
+#include <type_traits>
+
 namespace kushner {
 
-template <class Model, class ExecSpace, class Real = double>
+/// Mixed: the `mixed` precision's kernel for a model with float increments (has_float_increments): its normals,
+/// Euler-Maruyama increments and weights' exps in float, compiled apart so that fp64's kernel carries none of it.
+template <class Model, class ExecSpace, class Real = double, bool Mixed = false>
 struct ParticleTeamPairStep {
   using MemSpace = typename ExecSpace::memory_space;
   using Team = typename Kokkos::TeamPolicy<ExecSpace>::member_type;
   using Scratch = Kokkos::View<double*, typename ExecSpace::scratch_memory_space, Kokkos::MemoryUnmanaged>;
   static constexpr int n = Model::state_dim, p = Model::obs_dim;
+  static_assert(!Mixed || (std::is_same_v<Real, double> && has_float_increments<Model>), "mixed's own kernel");
+  static constexpr bool float_exp = std::is_same_v<Real, float> || Mixed;  // add_shifted_particle
   ParticleStepData<Model, MemSpace, Real> d;       // step k: its inputs, increments and partials
   ParticleSecondStep<Model, MemSpace, Real> next;  // step k + 1: its outputs, increments and partials
   // No control: a closed loop's second control depends on the first step's posterior (step_pair refuses one).
   KOKKOS_INLINE_FUNCTION static typename Model::Control uncontrolled() { return Model::Control::zero(); }
 
   static std::size_t scratch_bytes(int team_size) { return team_sum_scratch_bytes<n>(team_size); }
+
+  /// Known at compile time in fp32's and mixed's own kernels; a run-time flag elsewhere (mixed without them).
+  KOKKOS_INLINE_FUNCTION bool float_normals() const { return Mixed || d.float_normals(); }
 
   KOKKOS_INLINE_FUNCTION void step_chunk(const Team& team, int member, int chunk) const {
     const ParticleChunk c = particle_chunk(team, chunk, d.block_size, d.num_particles);
@@ -45,13 +54,13 @@ struct ParticleTeamPairStep {
       step_particles(member, c, ref, vinv_dy, shift, w);
     }
     // Step k's resum recomputes it from the pass's inputs; step k + 1's reads the values just stored.
-    team_moments_at_shift<Real>(team, buffer, shift[0], w[0], [&](double s, WeightedMoments<n>& v) {
+    team_moments_at_shift<float_exp>(team, buffer, shift[0], w[0], [&](double s, WeightedMoments<n>& v) {
       resum_first_step(member, c, ref, vinv_dy[0], s, v);
     });
     if (c.rank == 0) w[0].store(d.partials, chunk, member);
-    team_moments_at_shift<Real>(team, buffer, shift[1], w[1], [&](double s, WeightedMoments<n>& v) {
+    team_moments_at_shift<float_exp>(team, buffer, shift[1], w[1], [&](double s, WeightedMoments<n>& v) {
       for (int j = c.begin + c.rank; j < c.end; j += c.threads)
-        add_shifted_particle<Real>(next.log_weight(j, member) - s, load_particle<n>(next.x, j, member) - ref, v);
+        add_shifted_particle<float_exp>(next.log_weight(j, member) - s, load_particle<n>(next.x, j, member) - ref, v);
     });
     if (c.rank == 0) w[1].store(next.partials, chunk, member);
   }
@@ -88,13 +97,14 @@ struct ParticleTeamPairStep {
       for (int s = 0; s < 2; ++s) {
         Vec<K> z[B];
         double u[B];
-        draw_particle_batch<Model, false>(key, member, base, c.threads, d.step + s, d.float_normals(), z, u);
+        draw_particle_batch<Model, false>(key, member, base, c.threads, d.step + s, float_normals(), z, u);
         KUSHNER_DEVICE_UNROLL
         for (int k = 0; k < B; ++k) {
           const int j = batch_particle(base, k, c.threads);
           if (j >= c.end) continue;
-          const double l = update_particle<false>(d, step_time(s), precision<S>(s), z[k], u[k], lw[k],
-                                                  s == 0 ? log_normalizer : 0.0, vinv_dy_s[s], uncontrolled(), x[k]);
+          const double l =
+              update_particle<false, Mixed>(d, step_time(s), precision<S>(s), z[k], u[k], lw[k],
+                                            s == 0 ? log_normalizer : 0.0, vinv_dy_s[s], uncontrolled(), x[k]);
           if (s == 1) {
             KUSHNER_DEVICE_UNROLL
             for (int i = 0; i < n; ++i) xo[j + i * stride] = static_cast<Real>(x[k][i]);
@@ -102,7 +112,7 @@ struct ParticleTeamPairStep {
           }
           lw[k] = l;
           top[s] = l > top[s] ? l : top[s];
-          add_shifted_particle<Real>(l - shift[s], x[k] - ref, w[s]);
+          add_shifted_particle<float_exp>(l - shift[s], x[k] - ref, w[s]);
         }
       }
     }
@@ -120,14 +130,14 @@ struct ParticleTeamPairStep {
     for (int pair = c.begin / 2 + c.rank; pair < (c.end + 1) / 2; pair += c.threads) {
       Vec<K> z[2];
       double u[2];
-      draw_particle_pair<Model, false>(key, member, pair, d.step, d.float_normals(), z[0], z[1], u[0], u[1]);
+      draw_particle_pair<Model, false>(key, member, pair, d.step, float_normals(), z[0], z[1], u[0], u[1]);
       for (int k = 0; k < 2; ++k) {
         const int j = 2 * pair + k;
         if (j >= c.end) continue;
         Vec<n> x = load_particle<n>(d.x, j, member);
-        const double l = update_particle<false>(d, d.t, precision<S>(0), z[k], u[k], d.log_weight(j, member),
-                                                log_normalizer, vinv_dy_s, uncontrolled(), x);
-        add_shifted_particle<Real>(l - shift, x - ref, w);
+        const double l = update_particle<false, Mixed>(d, d.t, precision<S>(0), z[k], u[k], d.log_weight(j, member),
+                                                       log_normalizer, vinv_dy_s, uncontrolled(), x);
+        add_shifted_particle<float_exp>(l - shift, x - ref, w);
       }
     }
   }

@@ -6,17 +6,26 @@
 
 #include <Kokkos_Core.hpp>
 
+#include <type_traits>
+
 namespace kushner {
 
-template <class Model, class ExecSpace, class Real = double>
+/// Mixed: the `mixed` precision's kernel for a model with float increments (has_float_increments): its normals,
+/// Euler-Maruyama increments and weights' exps in float, compiled apart so that fp64's kernel carries none of it.
+template <class Model, class ExecSpace, class Real = double, bool Mixed = false>
 struct ParticleTeamStep {
   using MemSpace = typename ExecSpace::memory_space;
   using Team = typename Kokkos::TeamPolicy<ExecSpace>::member_type;
   using Scratch = Kokkos::View<double*, typename ExecSpace::scratch_memory_space, Kokkos::MemoryUnmanaged>;
   static constexpr int n = Model::state_dim, p = Model::obs_dim;
+  static_assert(!Mixed || (std::is_same_v<Real, double> && has_float_increments<Model>), "mixed's own kernel");
+  static constexpr bool float_exp = std::is_same_v<Real, float> || Mixed;  // add_shifted_particle
   ParticleStepData<Model, MemSpace, Real> d;
 
   static std::size_t scratch_bytes(int team_size) { return team_sum_scratch_bytes<n>(team_size); }
+
+  /// Known at compile time in fp32's and mixed's own kernels; a run-time flag elsewhere (mixed without them).
+  KOKKOS_INLINE_FUNCTION bool float_normals() const { return Mixed || d.float_normals(); }
 
   KOKKOS_INLINE_FUNCTION void step_chunk(const Team& team, int member, int chunk) const {
     const ParticleChunk c = particle_chunk(team, chunk, d.block_size, d.num_particles);
@@ -35,9 +44,9 @@ struct ParticleTeamStep {
         step_particles<false>(member, c, ref, vinv_dy, shift, w);
       }
     }
-    team_moments_at_shift<Real>(team, buffer, shift, w, [&](double s, WeightedMoments<n>& v) {
+    team_moments_at_shift<float_exp>(team, buffer, shift, w, [&](double s, WeightedMoments<n>& v) {
       for (int j = c.begin + c.rank; j < c.end; j += c.threads)
-        add_shifted_particle<Real>(d.log_weight(j, member) - s, load_particle<n>(d.x, j, member) - ref, v);
+        add_shifted_particle<float_exp>(d.log_weight(j, member) - s, load_particle<n>(d.x, j, member) - ref, v);
     });
     if (c.rank == 0) w.store(d.partials, chunk, member);
   }
@@ -68,18 +77,18 @@ struct ParticleTeamStep {
       load_particle_batch<n, Initialize>(xm, lwm, stride, base, c.threads, c.end, x, lw);
       Vec<K> z[B];
       double u[B];
-      draw_particle_batch<Model, Initialize>(key, member, base, c.threads, step, d.float_normals(), z, u);
+      draw_particle_batch<Model, Initialize>(key, member, base, c.threads, step, float_normals(), z, u);
       KUSHNER_DEVICE_UNROLL
       for (int k = 0; k < B; ++k) {
         const int j = batch_particle(base, k, c.threads);
         if (j >= c.end) continue;
-        const double l =
-            update_particle<Initialize>(d, d.t, precision, z[k], u[k], lw[k], log_normalizer, vinv_dy_s, control, x[k]);
+        const double l = update_particle<Initialize, Mixed>(d, d.t, precision, z[k], u[k], lw[k], log_normalizer,
+                                                            vinv_dy_s, control, x[k]);
         KUSHNER_DEVICE_UNROLL
         for (int i = 0; i < n; ++i) xm[j + i * stride] = static_cast<Real>(x[k][i]);
         lwm[j] = static_cast<Real>(l);
         top = l > top ? l : top;
-        add_shifted_particle<Real>(l - shift, x[k] - ref, w);
+        add_shifted_particle<float_exp>(l - shift, x[k] - ref, w);
       }
     }
     w.max_log_weight = top;

@@ -81,6 +81,13 @@ struct ParticleStepData {
   /// knows (fp32's kernels carry no fp64 Box-Muller), else as fp32_normals says.
   KOKKOS_INLINE_FUNCTION bool float_normals() const { return std::is_same_v<Real, float> || fp32_normals; }
 
+  /// Whether a particle's Euler-Maruyama increment f dt + G dw is computed in float and added to its double state:
+  /// the `mixed` precision, for a model whose increments can be taken in float (has_float_increments). Kernels take
+  /// it as their FloatIncrements parameter (update_particle), not from here at every particle.
+  KOKKOS_INLINE_FUNCTION bool float_increments() const {
+    return std::is_same_v<Real, double> && has_float_increments<Model> && fp32_normals;
+  }
+
   /// Sets the step's length dt and what the kernels take from it.
   void set_step_length(const double step_length) {
     dt = step_length;
@@ -201,8 +208,30 @@ KOKKOS_INLINE_FUNCTION double round_to_storage(Vec<N>& x, double l) {
 }
 
 namespace detail {
+/// x + f(t, x) dt + G(t, x) sqrt(dt) z in S; with FloatIncrements (`mixed`: ParticleStepData::float_increments) the
+/// increment f dt + G sqrt(dt) z is computed in float, from x rounded to float, and added to x in double: it moves
+/// by about 6e-8 of itself and of |x f'(x)| dt, as much as the float normal's rounding moves it, and the state keeps
+/// double's precision over many steps (tests/test_particle_filter.cpp, MixedTakesFloatIncrementsOfADoubleState).
+template <bool FloatIncrements, class S, class Model, class MemSpace, class Real, int K>
+KOKKOS_INLINE_FUNCTION Vec<Model::state_dim, S> euler_maruyama_step(const ParticleStepData<Model, MemSpace, Real>& d,
+                                                                    double t, const Vec<Model::state_dim, S>& x,
+                                                                    const Vec<K>& z,
+                                                                    const typename Model::Control& control) {
+  if constexpr (FloatIncrements) {
+    static_assert(std::is_same_v<S, double> && has_float_increments<Model>, "float increments of a double state");
+    const Vec<Model::state_dim, float> xf = convert<float>(x);
+    const Vec<Model::state_dim, float> dx =
+        d.model.drift(t, xf, control) * d.template dt_as<float>() +
+        d.model.diffusion(t, xf) * (convert<float>(z) * d.template sqrt_dt_as<float>());
+    return x + convert<double>(dx);
+  } else {
+    return x + d.model.drift(t, x, control) * d.template dt_as<S>() +
+           d.model.diffusion(t, x) * (convert<S>(z) * d.template sqrt_dt_as<S>());
+  }
+}
+
 /// update_particle before its results are rounded to the bank's storage.
-template <bool Initialize, class Model, class MemSpace, class Real, class P>
+template <bool Initialize, bool FloatIncrements, class Model, class MemSpace, class Real, class P>
 KOKKOS_INLINE_FUNCTION double update_particle_unrounded(
     const ParticleStepData<Model, MemSpace, Real>& d, double t, const Mat<Model::obs_dim, Model::obs_dim, P>& precision,
     const Vec<particle_draw_dim<Model, Initialize>>& z, double u, double log_weight, double log_normalizer,
@@ -228,8 +257,7 @@ KOKKOS_INLINE_FUNCTION double update_particle_unrounded(
     if constexpr (has_exact_transition<Model>::value) {
       xs = d.model.sample_exact_transition(t, xs, d.dt, z, u);
     } else {
-      xs = xs + d.model.drift(t, xs, control) * d.template dt_as<S>() +
-           d.model.diffusion(t, xs) * (convert<S>(z) * d.template sqrt_dt_as<S>());
+      xs = euler_maruyama_step<FloatIncrements>(d, t, xs, z, control);
     }
     const Vec<p, S> h = d.model.observation(t + d.dt, xs);
     const S increment = dot(h, convert<S>(vinv_dy)) - d.template half_dt_as<S>() * dot(h, convert<S>(precision) * h);
@@ -249,16 +277,17 @@ KOKKOS_INLINE_FUNCTION double update_particle_unrounded(
 /// precision is the identity, so `vinv_dy` is z[k+1] itself. The step computes in particle_step_scalar (float only
 /// for fp32 and a model with float dynamics): `precision` and `vinv_dy` in double, or already rounded to that
 /// scalar (the GPU's kernels, once per member, not per particle); x and the log-weight come out as the bank stores
-/// them (stored_value).
-template <bool Initialize, class Model, class MemSpace, class Real, class P>
+/// them (stored_value). With FloatIncrements (`mixed`'s kernels: ParticleStepData::float_increments) the
+/// Euler-Maruyama increment is computed in float (euler_maruyama_step).
+template <bool Initialize, bool FloatIncrements = false, class Model, class MemSpace, class Real, class P>
 KOKKOS_INLINE_FUNCTION double update_particle(const ParticleStepData<Model, MemSpace, Real>& d, double t,
                                               const Mat<Model::obs_dim, Model::obs_dim, P>& precision,
                                               const Vec<particle_draw_dim<Model, Initialize>>& z, double u,
                                               double log_weight, double log_normalizer,
                                               const Vec<Model::obs_dim, P>& vinv_dy,
                                               const typename Model::Control& control, Vec<Model::state_dim>& x) {
-  const double l = detail::update_particle_unrounded<Initialize>(d, t, precision, z, u, log_weight, log_normalizer,
-                                                                 vinv_dy, control, x);
+  const double l = detail::update_particle_unrounded<Initialize, FloatIncrements>(d, t, precision, z, u, log_weight,
+                                                                                  log_normalizer, vinv_dy, control, x);
   return round_to_storage<Real>(x, l);
 }
 
