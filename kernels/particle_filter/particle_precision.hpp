@@ -13,7 +13,7 @@ namespace kushner {
 /// 6e-8 of the increment and of |x f'(x)| dt, the drift taken at x rounded to float, as much as the float normal's
 /// rounding moves it), and the GPU kernels' weights exp(l - shift) for the moments in float. A GPU's
 /// float log, sine, Box-Muller and exp cost a fraction of the fp64 ones in a step bound by the card's power cap
-/// (H100, sine, `step_pair`: 1.28e11 particle-steps/s against fp64's 8.1e10; perf/particle_filter.md). fp32: mixed's
+/// (H100, sine, `step_pair`: 1.30e11 particle-steps/s against fp64's 7.95e10; perf/particle_filter.md). fp32: mixed's
 /// normals, and the particles and their log-weights (and, while resampling, cumulative weights) stored in float: half
 /// the bytes moved per particle-step, and about half the memory per particle (the ancestor index stays an int). A
 /// particle's Euler-Maruyama step is computed in float where the model's dynamics take float (particle_step_scalar),
