@@ -483,7 +483,7 @@ TEST(ParticleFilterBank, MixedTakesFloatIncrementsOfADoubleState) {
     const double x0 = -3.0 + 6.0 * (k + 0.5) / 2000 + 1e-9 * k, z = std::sin(1e3 * k);
     Vec<1> xm{{x0}}, xd{{x0}};
     const double lm = step_one_particle<SineModel, double, true>(sine, Vec<1>{{z}}, xm);
-    const double ld = step_one_particle<SineModel, double>(sine, Vec<1>{{z}}, xd);
+    step_one_particle<SineModel, double>(sine, Vec<1>{{z}}, xd);  // fp64's step of the same particle
     const float xf = static_cast<float>(x0);
     const float dx = (-std::sin(xf)) * 0.01f + static_cast<float>(sine.q) * (static_cast<float>(z) * std::sqrt(0.01f));
     ASSERT_NEAR(xm[0] - x0, dx, 4e-7 * std::abs(dx) + 1e-15) << x0;
