@@ -24,7 +24,8 @@ struct ParticleTeamStep {
 
   static std::size_t scratch_bytes(int team_size) { return team_sum_scratch_bytes<n>(team_size); }
 
-  /// Known at compile time in fp32's and mixed's own kernels; a run-time flag elsewhere (mixed without them).
+  /// Known at compile time in fp32's and mixed's own kernels; a run-time flag in fp64's, which also run mixed for a
+  /// model without float increments (its normals alone in float).
   KOKKOS_INLINE_FUNCTION bool float_normals() const { return Mixed || d.float_normals(); }
 
   KOKKOS_INLINE_FUNCTION void step_chunk(const Team& team, int member, int chunk) const {
