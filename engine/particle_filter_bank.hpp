@@ -312,7 +312,7 @@ class ParticleFilterBank {
   /// float increments (those kernels of its own), else false (fp64's kernels, and mixed's normals as a run-time flag).
   template <class F>
   void with_team_arithmetic(F&& f) {
-    if constexpr (std::is_same_v<Real, double> && has_float_increments<Model>) {
+    if constexpr (has_mixed_increments<Model, Real>) {
       if (options_.precision == ParticlePrecision::mixed) {
         f(std::true_type());
         return;

@@ -175,7 +175,7 @@ struct ParticleBlockStep {
       particle_block_host<true, false>(d, member, block);
       return;
     }
-    if constexpr (std::is_same_v<Real, double> && has_float_increments<Model>) {  // `mixed`: a loop of its own
+    if constexpr (has_mixed_increments<Model, Real>) {  // `mixed`: a loop of its own
       if (d.float_increments()) {
         particle_block_host<false, true>(d, member, block);
         return;

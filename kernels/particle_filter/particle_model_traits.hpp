@@ -44,6 +44,11 @@ template <class Model>
 constexpr bool has_float_increments =
     !Model::discrete_time && !has_exact_transition<Model>::value && has_float_dynamics<Model>::value;
 
+/// Whether particles stored as Real take the `mixed` precision's float increments of a double state: the kernels of
+/// mixed's own (ParticleTeamStep/ParticleTeamPairStep's Mixed, particle_block_host's FloatIncrements) exist only then.
+template <class Model, class Real>
+constexpr bool has_mixed_increments = std::is_same_v<Real, double> ? has_float_increments<Model> : false;
+
 /// The scalar a particle's Euler-Maruyama step is computed in, for particles stored as Real: float where they are
 /// stored in float and the model has float increments, else double (as are exact and discrete-time transitions).
 template <class Model, class Real>

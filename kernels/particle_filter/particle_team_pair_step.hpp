@@ -22,7 +22,7 @@ struct ParticleTeamPairStep {
   using Team = typename Kokkos::TeamPolicy<ExecSpace>::member_type;
   using Scratch = Kokkos::View<double*, typename ExecSpace::scratch_memory_space, Kokkos::MemoryUnmanaged>;
   static constexpr int n = Model::state_dim, p = Model::obs_dim;
-  static_assert(!Mixed || (std::is_same_v<Real, double> && has_float_increments<Model>), "mixed's own kernel");
+  static_assert(!Mixed || has_mixed_increments<Model, Real>, "mixed's own kernel");
   static constexpr bool float_exp = std::is_same_v<Real, float> || Mixed;  // add_shifted_particle
   ParticleStepData<Model, MemSpace, Real> d;       // step k: its inputs, increments and partials
   ParticleSecondStep<Model, MemSpace, Real> next;  // step k + 1: its outputs, increments and partials

@@ -84,9 +84,7 @@ struct ParticleStepData {
   /// Whether a particle's Euler-Maruyama increment f dt + G dw is computed in float and added to its double state:
   /// the `mixed` precision, for a model whose increments can be taken in float (has_float_increments). Kernels take
   /// it as their FloatIncrements parameter (update_particle), not from here at every particle.
-  KOKKOS_INLINE_FUNCTION bool float_increments() const {
-    return std::is_same_v<Real, double> && has_float_increments<Model> && fp32_normals;
-  }
+  KOKKOS_INLINE_FUNCTION bool float_increments() const { return has_mixed_increments<Model, Real> && fp32_normals; }
 
   /// Sets the step's length dt and what the kernels take from it.
   void set_step_length(const double step_length) {
@@ -218,7 +216,7 @@ KOKKOS_INLINE_FUNCTION Vec<Model::state_dim, S> euler_maruyama_step(const Partic
                                                                     const Vec<K>& z,
                                                                     const typename Model::Control& control) {
   if constexpr (FloatIncrements) {
-    static_assert(std::is_same_v<S, double> && has_float_increments<Model>, "float increments of a double state");
+    static_assert(has_mixed_increments<Model, S>, "float increments of a double state");
     const Vec<Model::state_dim, float> xf = convert<float>(x);
     const Vec<Model::state_dim, float> dx =
         d.model.drift(t, xf, control) * d.template dt_as<float>() +
