@@ -42,6 +42,13 @@ KOKKOS_INLINE_FUNCTION bool is_finite(double v) {
   return (bits_of(v) & 0x7ff0000000000000ull) != 0x7ff0000000000000ull;
 }
 
+/// is_finite of a float, from its exponent bits as is_finite(double).
+KOKKOS_INLINE_FUNCTION bool is_finite(float v) {
+  std::uint32_t bits;
+  std::memcpy(&bits, &v, sizeof bits);
+  return (bits & 0x7f800000u) != 0x7f800000u;
+}
+
 /// A quiet NaN, built from its bit pattern: std::numeric_limits is not device-callable everywhere.
 KOKKOS_INLINE_FUNCTION double quiet_nan() { return from_bits(0x7ff8000000000000ull); }
 
@@ -240,6 +247,21 @@ KOKKOS_INLINE_FUNCTION float sin(float x) {
   return __sinf(r);
 #else
   return impl::sin(x);
+#endif
+}
+
+/// e^x in float for a particle's weight, exp(l - shift) with |l - shift| <= 60 or e^x far below a float's range. On
+/// a GPU the special-function unit's 2^y of y = x log2(e) rounded to float, as CUDA's __expf computes it, in its
+/// flush-to-zero form (2 instructions against expf's 8; e^x below 2^-126, x < -87.3, is 0). Its bound, __expf's:
+/// 2 + floor(1.173 |x|) float ulps, 8.6e-6 relative at |x| = 60; at most about twice what rounding x = l - shift to
+/// float (|x| 2^-24) already moves e^x. Elsewhere expf.
+KOKKOS_INLINE_FUNCTION float weight_exp(float x) {
+#if KUSHNER_CUDA_DEVICE_PASS
+  float e;
+  asm("ex2.approx.ftz.f32 %0, %1;" : "=f"(e) : "f"(x * 1.44269504f));
+  return e;
+#else
+  return impl::exp(x);
 #endif
 }
 

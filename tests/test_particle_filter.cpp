@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <limits>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -339,15 +340,15 @@ void expect_close(const PosteriorCopy& got, const PosteriorCopy& want, const std
 }
 
 TEST(ParticleFilterBank, MixedAndFp32TeamKernelAgreesWithHostBlockKernel) {
-  // With fp32 normals the two kernels' float math libraries (libmvec's logf and cosf in SIMD lanes, libm's
-  // scalar ones) may differ in a float's last bit, about 1e-7 of a normal: after 40 steps with resampling mixed's
-  // posteriors agree to that level. fp32 steps the sine particles in float (sinf in SIMD lanes or not) and the team
-  // kernel takes the weights' exp in float: weights that differ by 1e-7 move a systematic point across a particle now
-  // and then, which moves the mean by about a particle's distance over N (measured 3.0e-4). Against the finer
-  // precision (mixed against fp64, fp32 against mixed) they differ, but by less than 10 particles' distance over N:
-  // mixed by its normals' and float increments' rounding, which here moved a systematic point across a particle
-  // (measured 2.4e-5; 1.6e-7 when only the normals were floats), fp32 by the few systematic points that its float
-  // cumulative weights put on the other side of a particle (measured 1.8e-3, against a Monte Carlo error near 2e-2).
+  // With fp32 normals the two kernels' float math libraries (libmvec's logf and cosf in SIMD lanes, libm's scalar ones)
+  // may differ in a float's last bit, about 1e-7 of a normal: after 40 steps with resampling mixed's posteriors agree
+  // to that level. fp32 steps the sine particles in float (sinf in SIMD lanes or not) and the team kernel takes the
+  // weights' exp in float, relative to a shift rounded to float: weights that differ by 1e-7 can move a systematic
+  // point across a particle, which moves the mean by about a particle's distance over N (measured 4.4e-7 here; 3.0e-4
+  // with earlier kernels). Against the finer precision (mixed against fp64, fp32 against mixed) they differ, but by
+  // less than 10 particles' distance over N: mixed by its normals' and float increments' rounding, which here moved a
+  // systematic point across a particle (measured 2.4e-5; 1.6e-7 when only the normals were floats), fp32 by its float
+  // steps and cumulative weights (measured 2.2e-7; 1.8e-3 with earlier kernels, against a Monte Carlo error near 2e-2).
   for (auto precision : {ParticlePrecision::mixed, ParticlePrecision::fp32}) {
     ParticleFilterOptions block, team;
     block.kernel = ParticleKernel::host_block;
@@ -433,6 +434,19 @@ double step_one_particle(const Model& model, const Vec<Model::noise_dim>& z, Vec
                                                  Model::Control::zero(), x);
 }
 
+/// step_one_particle's step of a particle held in float between steps, as fp32's team kernels hold a model's particles
+/// whose step computes in float (update_particle's float overload), from x0 with log-weight lw.
+template <class Model>
+float step_one_held_particle(const Model& model, const Vec<Model::noise_dim>& z, float lw,
+                             Vec<Model::state_dim, float>& x) {
+  ParticleStepData<Model, Kokkos::HostSpace, float> d;
+  d.model = model;
+  d.set_step_length(0.01);
+  const Mat<Model::obs_dim, Model::obs_dim> precision = Mat<Model::obs_dim, Model::obs_dim>::diagonal(4.0);
+  const Vec<Model::obs_dim> vinv_dy = Vec<Model::obs_dim>::constant(0.013);
+  return update_particle<false>(d, 0.0, precision, z, 0.0, lw, 0.125, vinv_dy, Model::Control::zero(), x);
+}
+
 TEST(ParticleFilterBank, Fp32StepsInFloatWhereTheModelTakesFloat) {
   // fp32 computes a particle's Euler-Maruyama step in float where the model's dynamics take float (cheaper on a
   // GPU); elsewhere in double, rounded once where stored (models without float dynamics, exact transitions).
@@ -456,6 +470,10 @@ TEST(ParticleFilterBank, Fp32StepsInFloatWhereTheModelTakesFloat) {
     ASSERT_NEAR(lf, l1, 4e-7 * std::abs(l1)) << x0;
     ASSERT_EQ(xf[0], static_cast<double>(static_cast<float>(xf[0])));  // stored as float
     sine_rounded_differently += xf[0] != static_cast<double>(static_cast<float>(xd[0]));
+    // Held in float from load to store (the team kernels): the same bits.
+    Vec<1, float> held{{static_cast<float>(x0)}};
+    ASSERT_EQ(step_one_held_particle(sine, Vec<1>{{z}}, -7.25f, held), lf) << x0;
+    ASSERT_EQ(held[0], xf[0]) << x0;
     // The cubic oscillator's dynamics are double-only: its fp32 step is the fp64 step rounded once.
     Vec<2> cf{{x0, 0.5 * x0}}, cd{{x0, 0.5 * x0}};
     const double clf = step_one_particle<CubicOscillatorModel, float>(cubic, Vec<1>{{z}}, cf);
@@ -467,6 +485,59 @@ TEST(ParticleFilterBank, Fp32StepsInFloatWhereTheModelTakesFloat) {
   std::cout << "sine: fp32 step differs from the rounded fp64 step for " << sine_rounded_differently
             << " of 2000 particles\n";
   EXPECT_GT(sine_rounded_differently, 100);
+  // A particle that left the numbers keeps its log-weight -inf in float too, and a dead one (-inf) stays so.
+  Vec<1, float> lost{{std::nanf("")}}, dead{{0.5f}};
+  EXPECT_EQ(step_one_held_particle(sine, Vec<1>{{0.3}}, -7.25f, lost), -std::numeric_limits<float>::infinity());
+  EXPECT_EQ(step_one_held_particle(sine, Vec<1>{{0.3}}, -std::numeric_limits<float>::infinity(), dead),
+            -std::numeric_limits<float>::infinity());
+  EXPECT_TRUE(std::isfinite(dead[0]));
+}
+
+/// math::weight_exp on `Space` of each argument.
+template <class Space>
+std::vector<float> weight_exps(const std::vector<float>& arguments) {
+  using Memory = typename Space::memory_space;
+  const int count = static_cast<int>(arguments.size());
+  Kokkos::View<float*, Memory> x("x", count), e("e", count);
+  Kokkos::deep_copy(x, Kokkos::View<const float*, Kokkos::HostSpace>(arguments.data(), count));
+  Kokkos::parallel_for(
+      "test::weight_exp", Kokkos::RangePolicy<Space>(0, count),
+      KOKKOS_LAMBDA(const int i) { e(i) = math::weight_exp(x(i)); });
+  std::vector<float> out(count);
+  Kokkos::deep_copy(Kokkos::View<float*, Kokkos::HostSpace>(out.data(), count), e);
+  return out;
+}
+
+template <class Space>
+class WeightExp : public ::testing::Test {};
+TYPED_TEST_SUITE(WeightExp, test::ExecutionSpaces);
+
+/// The fp32 and mixed kernels' weight exp (math::weight_exp: the special-function unit's on a GPU) against exp in
+/// double on every backend: within __expf's bound, 2 + floor(1.173 |x|) float ulps of the result, over the arguments
+/// l - shift that the team kernels give it (within 60 of the shift; past that they sum again) and on to where e^x
+/// leaves the normal floats; below that at most the smallest normal float; zero for a dead particle's -inf.
+TYPED_TEST(WeightExp, IsWithinItsBoundOfExp) {
+  std::vector<float> x;
+  for (int i = 0; i <= (1 << 20); ++i) x.push_back(-87.0f + 147.0f * static_cast<float>(i) / (1 << 20));
+  for (float below : {-87.5f, -100.0f, -1e4f, -std::numeric_limits<float>::infinity()}) x.push_back(below);
+  const std::vector<float> e = weight_exps<TypeParam>(x);
+  double worst = 0.0;
+  int outside = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const double exact = std::exp(static_cast<double>(x[i]));
+    if (exact < 0x1p-126) {
+      outside += !(e[i] >= 0.0f && e[i] <= 0x1p-126f);
+      continue;
+    }
+    int exponent;
+    std::frexp(static_cast<float>(exact), &exponent);
+    const double ulp = std::ldexp(1.0, exponent - 24), bound = (2.0 + std::floor(1.173 * std::abs(x[i]))) * ulp;
+    outside += !(std::abs(e[i] - exact) <= bound);
+    worst = std::max(worst, std::abs(e[i] - exact) / bound);
+  }
+  EXPECT_EQ(outside, 0) << "largest error over its bound " << worst;
+  EXPECT_EQ(e.back(), 0.0f);
+  std::cout << "largest error over its bound " << worst << "\n";
 }
 
 TEST(ParticleFilterBank, MixedTakesFloatIncrementsOfADoubleState) {

@@ -11,6 +11,8 @@
 
 #include <Kokkos_Core.hpp>
 
+#include <type_traits>
+
 namespace kushner {
 
 /// Where the team's sums are too far from their shift (particles far from the observation, an extreme dy)
@@ -42,20 +44,21 @@ KOKKOS_INLINE_FUNCTION int batch_particle(int base, int k, int threads) {
 }
 
 /// Loads the batch's particles (and log-weights, unless initializing) from one member's columns: xm[j + i * stride]
-/// and lwm[j]. Slots past `end` are left as they are.
-template <int N, bool Initialize, class Real>
+/// and lwm[j], as H: the scalar a step computes in (float for fp32's float steps, which hold their particles in float
+/// from load to store; else double). Slots past `end` are left as they are.
+template <int N, bool Initialize, class Real, class H>
 KOKKOS_INLINE_FUNCTION void load_particle_batch(const Real* xm, const Real* lwm, std::size_t stride, int base,
-                                                int threads, int end, Vec<N>* x, double* lw) {
+                                                int threads, int end, Vec<N, H>* x, H* lw) {
   KUSHNER_DEVICE_UNROLL
   for (int k = 0; k < 2 * device_pairs_per_batch; ++k) {
     const int j = batch_particle(base, k, threads);
     if (j < end) {
       KUSHNER_DEVICE_UNROLL
       for (int i = 0; i < N; ++i) x[k][i] = xm[j + i * stride];
-      lw[k] = Initialize ? 0.0 : lwm[j];
+      lw[k] = Initialize ? H(0) : lwm[j];
     } else {  // past the end: never stepped, but defined (GCC cannot see that the step skips it too)
-      x[k] = Vec<N>::zero();
-      lw[k] = 0.0;
+      x[k] = Vec<N, H>::zero();
+      lw[k] = H(0);
     }
   }
 }
@@ -71,13 +74,26 @@ KOKKOS_INLINE_FUNCTION void draw_particle_batch(const RngKey& key, int member, i
                                           u[2 * b + 1]);
 }
 
-/// Adds a particle of log-weight l - shift; weight zero adds nothing (its x may not be finite). Its weight's exp is
-/// taken in float with FloatExp (the fp32 and mixed kernels: a GPU's fp64 exp costs several times the energy of its
-/// float one), the sums in double.
-template <bool FloatExp, int N>
-KOKKOS_INLINE_FUNCTION void add_shifted_particle(double shifted, const Vec<N>& dx, WeightedMoments<N>& w) {
-  const double e = FloatExp ? static_cast<double>(math::exp(static_cast<float>(shifted))) : math::exp(shifted);
+/// Adds a particle of log-weight l - shift (`shifted`, a float where the kernel holds its particles in float); weight
+/// zero adds nothing (its x may not be finite). Its weight's exp is taken in float with FloatExp (the fp32 and mixed
+/// kernels: a GPU's fp64 exp costs several times the energy of its float one; math::weight_exp), the sums in double.
+template <bool FloatExp, int N, class T>
+KOKKOS_INLINE_FUNCTION void add_shifted_particle(T shifted, const Vec<N>& dx, WeightedMoments<N>& w) {
+  static_assert(FloatExp || std::is_same_v<T, double>, "an fp64 weight's l - shift in double");
+  double e;
+  if constexpr (FloatExp)
+    e = math::weight_exp(static_cast<float>(shifted));
+  else
+    e = math::exp(shifted);
   if (e > 0.0) w.add_weight(e, dx);
+}
+
+/// A member's shift as a team kernel whose particles are held in H takes it: rounded to a float where H is float
+/// (fp32's float steps), so that a particle's l - shift is one float subtraction, the double difference's rounding to
+/// float (past float's range, shift becomes infinite and the team sums again relative to its largest l).
+template <class H>
+KOKKOS_INLINE_FUNCTION double team_shift(double shift) {
+  return std::is_same_v<H, float> ? static_cast<double>(static_cast<float>(shift)) : shift;
 }
 
 /// The team's moments of one step: w holds the thread's sums relative to `shift` and (in max_log_weight) its

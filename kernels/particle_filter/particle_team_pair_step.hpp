@@ -50,7 +50,7 @@ struct ParticleTeamPairStep {
         const Vec<p> dy = load<p>(s == 0 ? d.dy : next.dy, member);
         vinv_dy[s] = precision<double>(s) * dy;
         bound += log_weight_bound(d.model, dy, vinv_dy[s], d.dt);
-        shift[s] = bound;
+        shift[s] = team_shift<S>(bound);
       }
       step_particles(member, c, ref, vinv_dy, shift, w);
     }
@@ -67,7 +67,8 @@ struct ParticleTeamPairStep {
   }
 
  private:
-  using S = particle_step_scalar<Model, Real>;  // V^-1 and V^-1 dy are rounded to it once, not for every particle
+  // V^-1 and V^-1 dy are rounded to it once, not for every particle; fp32's float steps hold their particles in it.
+  using S = particle_step_scalar<Model, Real>;
 
   /// Step s of the pass: its start time and V^{-1} there.
   KOKKOS_INLINE_FUNCTION double step_time(int s) const { return s == 0 ? d.t : next.t; }
@@ -82,7 +83,7 @@ struct ParticleTeamPairStep {
     constexpr int B = 2 * device_pairs_per_batch;
     constexpr int K = particle_draw_dim<Model, false>;
     const double log_normalizer = d.log_normalizer(member);
-    double top[2] = {-math::infinity(), -math::infinity()};
+    S top[2] = {static_cast<S>(-math::infinity()), static_cast<S>(-math::infinity())};
     const Real* const xm = &d.x(0, member, 0);
     const Real* const lwm = &d.log_weight(0, member);
     Real* const xo = &next.x(0, member, 0);
@@ -90,9 +91,10 @@ struct ParticleTeamPairStep {
     const std::size_t stride = d.x.stride_2();  // the same for next.x
     const RngKey key = particle_draw_key<false>(d);
     const Vec<p, S> vinv_dy_s[2] = {convert<S>(vinv_dy[0]), convert<S>(vinv_dy[1])};
+    const S shift_s[2] = {static_cast<S>(shift[0]), static_cast<S>(shift[1])};  // team_shift<S>: exact
     for (int base = c.begin / 2 + c.rank; base < (c.end + 1) / 2; base += device_pairs_per_batch * c.threads) {
-      Vec<n> x[B];
-      double lw[B];
+      Vec<n, S> x[B];  // fp32's float steps hold their particles in float
+      S lw[B];
       load_particle_batch<n, false>(xm, lwm, stride, base, c.threads, c.end, x, lw);
       KUSHNER_DEVICE_UNROLL
       for (int s = 0; s < 2; ++s) {
@@ -103,9 +105,8 @@ struct ParticleTeamPairStep {
         for (int k = 0; k < B; ++k) {
           const int j = batch_particle(base, k, c.threads);
           if (j >= c.end) continue;
-          const double l =
-              update_particle<false, Mixed>(d, step_time(s), precision<S>(s), z[k], u[k], lw[k],
-                                            s == 0 ? log_normalizer : 0.0, vinv_dy_s[s], uncontrolled(), x[k]);
+          const S l = update_particle<false, Mixed>(d, step_time(s), precision<S>(s), z[k], u[k], lw[k],
+                                                    s == 0 ? log_normalizer : 0.0, vinv_dy_s[s], uncontrolled(), x[k]);
           if (s == 1) {
             KUSHNER_DEVICE_UNROLL
             for (int i = 0; i < n; ++i) xo[j + i * stride] = static_cast<Real>(x[k][i]);
@@ -113,7 +114,7 @@ struct ParticleTeamPairStep {
           }
           lw[k] = l;
           top[s] = l > top[s] ? l : top[s];
-          add_shifted_particle<float_exp>(l - shift[s], x[k] - ref, w[s]);
+          add_shifted_particle<float_exp>(l - shift_s[s], convert<double>(x[k]) - ref, w[s]);
         }
       }
     }

@@ -20,6 +20,8 @@ struct ParticleTeamStep {
   static constexpr int n = Model::state_dim, p = Model::obs_dim;
   static_assert(!Mixed || has_mixed_increments<Model, Real>, "mixed's own kernel");
   static constexpr bool float_exp = std::is_same_v<Real, float> || Mixed;  // add_shifted_particle
+  // V^-1 and V^-1 dy are rounded to it once, not for every particle; fp32's float steps hold their particles in it.
+  using S = particle_step_scalar<Model, Real>;
   ParticleStepData<Model, MemSpace, Real> d;
 
   static std::size_t scratch_bytes(int team_size) { return team_sum_scratch_bytes<n>(team_size); }
@@ -41,7 +43,7 @@ struct ParticleTeamStep {
       } else {
         const Vec<p> dy = load<p>(d.dy, member);
         const Vec<p> vinv_dy = d.observation_precision.value * dy;
-        shift = log_weight_bound(d.model, dy, vinv_dy, d.dt);
+        shift = team_shift<S>(log_weight_bound(d.model, dy, vinv_dy, d.dt));
         step_particles<false>(member, c, ref, vinv_dy, shift, w);
       }
     }
@@ -61,7 +63,7 @@ struct ParticleTeamStep {
     constexpr int B = 2 * device_pairs_per_batch;  // particles per batch
     constexpr int K = particle_draw_dim<Model, Initialize>;
     const double log_normalizer = Initialize ? 0.0 : d.log_normalizer(member);
-    double top = -math::infinity();
+    S top = static_cast<S>(-math::infinity());
     // The member's columns as pointers: one 64-bit address computation per thread, not per access.
     Real* const xm = &d.x(0, member, 0);
     Real* const lwm = &d.log_weight(0, member);
@@ -69,12 +71,12 @@ struct ParticleTeamStep {
     const RngKey key = particle_draw_key<Initialize>(d);
     const std::uint32_t step = particle_draw_step<Initialize>(d);
     const typename Model::Control control = particle_control(d, member);
-    using S = particle_step_scalar<Model, Real>;  // V^-1 and V^-1 dy rounded to it once, not for every particle
     const Mat<p, p, S>& precision = d.observation_precision.template as<S>();
     const Vec<p, S> vinv_dy_s = convert<S>(vinv_dy);
+    const S shift_s = static_cast<S>(shift);  // team_shift<S>: exact
     for (int base = c.begin / 2 + c.rank; base < (c.end + 1) / 2; base += device_pairs_per_batch * c.threads) {
-      Vec<n> x[B];
-      double lw[B];
+      Vec<n, S> x[B];  // fp32's float steps hold their particles in float
+      S lw[B];
       load_particle_batch<n, Initialize>(xm, lwm, stride, base, c.threads, c.end, x, lw);
       Vec<K> z[B];
       double u[B];
@@ -83,13 +85,13 @@ struct ParticleTeamStep {
       for (int k = 0; k < B; ++k) {
         const int j = batch_particle(base, k, c.threads);
         if (j >= c.end) continue;
-        const double l = update_particle<Initialize, Mixed>(d, d.t, precision, z[k], u[k], lw[k], log_normalizer,
-                                                            vinv_dy_s, control, x[k]);
+        const S l = update_particle<Initialize, Mixed>(d, d.t, precision, z[k], u[k], lw[k], log_normalizer, vinv_dy_s,
+                                                       control, x[k]);
         KUSHNER_DEVICE_UNROLL
         for (int i = 0; i < n; ++i) xm[j + i * stride] = static_cast<Real>(x[k][i]);
         lwm[j] = static_cast<Real>(l);
         top = l > top ? l : top;
-        add_shifted_particle<float_exp>(l - shift, x[k] - ref, w);
+        add_shifted_particle<float_exp>(l - shift_s, convert<double>(x[k]) - ref, w);
       }
     }
     w.max_log_weight = top;

@@ -228,13 +228,32 @@ KOKKOS_INLINE_FUNCTION Vec<Model::state_dim, S> euler_maruyama_step(const Partic
   }
 }
 
+/// A continuous-time particle's step in S (particle_step_scalar): xs moved by the model's exact transition or its
+/// Euler-Maruyama step, and its new log-weight, before the check that both are finite.
+template <bool FloatIncrements, class S, class Model, class MemSpace, class Real, class P>
+KOKKOS_FORCEINLINE_FUNCTION S continuous_time_step(
+    const ParticleStepData<Model, MemSpace, Real>& d, double t, const Mat<Model::obs_dim, Model::obs_dim, P>& precision,
+    const Vec<particle_draw_dim<Model, false>>& z, double u, double log_weight, double log_normalizer,
+    const Vec<Model::obs_dim, P>& vinv_dy, const typename Model::Control& control, Vec<Model::state_dim, S>& xs) {
+  static_assert(std::is_same_v<S, particle_step_scalar<Model, Real>>, "the step's scalar");
+  static_assert(std::is_same_v<P, double> || std::is_same_v<P, S>, "V^-1 in double or in the step's scalar");
+  if constexpr (has_exact_transition<Model>::value) {
+    xs = d.model.sample_exact_transition(t, xs, d.dt, z, u);
+  } else {
+    xs = euler_maruyama_step<FloatIncrements>(d, t, xs, z, control);
+  }
+  const Vec<Model::obs_dim, S> h = d.model.observation(t + d.dt, xs);
+  const S increment = dot(h, convert<S>(vinv_dy)) - d.template half_dt_as<S>() * dot(h, convert<S>(precision) * h);
+  return static_cast<S>(log_weight - log_normalizer) + increment;
+}
+
 /// update_particle before its results are rounded to the bank's storage.
 template <bool Initialize, bool FloatIncrements, class Model, class MemSpace, class Real, class P>
 KOKKOS_INLINE_FUNCTION double update_particle_unrounded(
     const ParticleStepData<Model, MemSpace, Real>& d, double t, const Mat<Model::obs_dim, Model::obs_dim, P>& precision,
     const Vec<particle_draw_dim<Model, Initialize>>& z, double u, double log_weight, double log_normalizer,
     const Vec<Model::obs_dim, P>& vinv_dy, const typename Model::Control& control, Vec<Model::state_dim>& x) {
-  constexpr int n = Model::state_dim, p = Model::obs_dim;
+  constexpr int n = Model::state_dim;
   if constexpr (Initialize) {
     x = d.initial_mean + d.initial_root * z;
     return 0.0;
@@ -250,16 +269,9 @@ KOKKOS_INLINE_FUNCTION double update_particle_unrounded(
     // In S: float where fp32 stores floats and the model's dynamics take float (particle_step_scalar), else double
     // (every convert<double> below is then a copy, and the expressions are those of the double step).
     using S = particle_step_scalar<Model, Real>;
-    static_assert(std::is_same_v<P, double> || std::is_same_v<P, S>, "V^-1 in double or in the step's scalar");
     Vec<n, S> xs = convert<S>(x);
-    if constexpr (has_exact_transition<Model>::value) {
-      xs = d.model.sample_exact_transition(t, xs, d.dt, z, u);
-    } else {
-      xs = euler_maruyama_step<FloatIncrements>(d, t, xs, z, control);
-    }
-    const Vec<p, S> h = d.model.observation(t + d.dt, xs);
-    const S increment = dot(h, convert<S>(vinv_dy)) - d.template half_dt_as<S>() * dot(h, convert<S>(precision) * h);
-    const double l = static_cast<S>(log_weight - log_normalizer) + increment;
+    const double l =
+        continuous_time_step<FloatIncrements>(d, t, precision, z, u, log_weight, log_normalizer, vinv_dy, control, xs);
     x = convert<double>(xs);
     bool finite = math::is_finite(l);
     KUSHNER_UNROLL_FULLY
@@ -287,6 +299,34 @@ KOKKOS_INLINE_FUNCTION double update_particle(const ParticleStepData<Model, MemS
   const double l = detail::update_particle_unrounded<Initialize, FloatIncrements>(d, t, precision, z, u, log_weight,
                                                                                   log_normalizer, vinv_dy, control, x);
   return round_to_storage<Real>(x, l);
+}
+
+/// update_particle of a particle held in float between a kernel's steps, for a step that computes in float (fp32 and
+/// a model with float dynamics: the GPU's team kernels hold such particles in float from load to store): the same x
+/// and log-weight, without a float's trip through double and back at every step (a GPU converts between them at a
+/// fraction of its float rate) and with the finite checks on the floats. A particle's first step (Initialize) is
+/// update_particle's.
+template <bool Initialize, bool FloatIncrements = false, class Model, class MemSpace, class P>
+KOKKOS_INLINE_FUNCTION float update_particle(const ParticleStepData<Model, MemSpace, float>& d, double t,
+                                             const Mat<Model::obs_dim, Model::obs_dim, P>& precision,
+                                             const Vec<particle_draw_dim<Model, Initialize>>& z, double u,
+                                             float log_weight, double log_normalizer,
+                                             const Vec<Model::obs_dim, P>& vinv_dy,
+                                             const typename Model::Control& control, Vec<Model::state_dim, float>& x) {
+  static_assert(std::is_same_v<particle_step_scalar<Model, float>, float>, "a step computed in float");
+  if constexpr (Initialize) {
+    Vec<Model::state_dim> xd = convert<double>(x);
+    const double l = update_particle<true>(d, t, precision, z, u, log_weight, log_normalizer, vinv_dy, control, xd);
+    x = convert<float>(xd);
+    return static_cast<float>(l);
+  } else {
+    const float l = detail::continuous_time_step<FloatIncrements>(d, t, precision, z, u, log_weight, log_normalizer,
+                                                                  vinv_dy, control, x);
+    bool finite = math::is_finite(l);
+    KUSHNER_UNROLL_FULLY
+    for (int i = 0; i < Model::state_dim; ++i) finite = finite & math::is_finite(x[i]);
+    return finite ? l : -static_cast<float>(math::infinity());
+  }
 }
 
 /// The largest log-likelihood increment any particle can get from an increment dy: h.a - (dt/2) h^T V^-1 h
