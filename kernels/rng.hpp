@@ -64,10 +64,48 @@ struct Counter {
   std::uint32_t member, particle, step, draw;
 };
 
+/// The low and high words of the 64-bit product a * M: on a GPU one mul.wide.u32, which ptxas makes one IMAD.WIDE.U32.
+template <std::uint32_t M>
+KOKKOS_FORCEINLINE_FUNCTION void multiply_wide(const std::uint32_t a, std::uint32_t& lo, std::uint32_t& hi) {
+#if KUSHNER_CUDA_DEVICE_PASS
+  asm("{\n .reg .u64 t;\n mul.wide.u32 t, %2, %3;\n mov.b64 {%0, %1}, t;\n}" : "=r"(lo), "=r"(hi) : "r"(a), "n"(M));
+#else
+  const std::uint64_t product = std::uint64_t{M} * a;
+  lo = static_cast<std::uint32_t>(product);
+  hi = static_cast<std::uint32_t>(product >> 32);
+#endif
+}
+
+/// Philox4x32-10 (Salmon et al. 2011) as a GPU takes it (philox_block), Random123's philox4x32 bit for bit
+/// (tests/test_rng.cpp, every backend; a host runs it in that test alone). Each round's two products are one
+/// multiply_wide each. From Random123's uint64 products (its R123_USE_64BIT path, which nvcc takes) LLVM carried the
+/// next round's xor and product into 64 bits (xor.b64, mul.lo.s64 of words whose high halves are zero), and ptxas
+/// took those in 32-bit pieces; from `__umulhi` and `a * b` it made an IMAD.HI.U32 and an IMAD of half the products.
+/// SASS for sm_90 of fp32's fused pair loop (two particles, two steps: two blocks): 403 instructions, 387 by
+/// `__umulhi`, 368 now (perf/particle_filter.md).
+KOKKOS_INLINE_FUNCTION r123array4x32 philox4x32_10(r123array4x32 c, r123array2x32 k) {
+  constexpr std::uint32_t m0 = 0xD2511F53u, m1 = 0xCD9E8D57u;  // Random123's PHILOX_M4x32_0, _1
+  constexpr std::uint32_t w0 = 0x9E3779B9u, w1 = 0xBB67AE85u;  // PHILOX_W32_0, _1: the key's bump per round
+  KUSHNER_DEVICE_UNROLL
+  for (int round = 0; round < 10; ++round) {
+    std::uint32_t lo0, hi0, lo1, hi1;
+    multiply_wide<m0>(c.v[0], lo0, hi0);
+    multiply_wide<m1>(c.v[2], lo1, hi1);
+    c = {{hi1 ^ c.v[1] ^ k.v[0], lo1, hi0 ^ c.v[3] ^ k.v[1], lo0}};
+    k.v[0] += w0;
+    k.v[1] += w1;
+  }
+  return c;
+}
+
 KOKKOS_INLINE_FUNCTION r123array4x32 philox_block(const RngKey& key, const Counter& c) {
   const r123array2x32 k = {{key.seed.value, static_cast<std::uint32_t>(key.stream)}};
   const r123array4x32 ctr = {{c.member + key.seed.first_member, c.particle, c.step, c.draw}};
-  return philox4x32(ctr, k);
+#if KUSHNER_CUDA_DEVICE_PASS
+  return philox4x32_10(ctr, k);
+#else
+  return philox4x32(ctr, k);  // the host code as before (simd_random.hpp has the vectorized rounds)
+#endif
 }
 
 /// Uniform in the open interval (0, 1) from two 32-bit words: the top 52 bits, offset by half a step, so

@@ -1,8 +1,8 @@
 // The host's Philox (kernels/particle_filter/simd_random.hpp: the scalar rounds GCC vectorizes, and the runs of lanes
-// that an AVX2 host draws four at a time) against Random123's (kernels/rng.hpp, used on the GPU): the same uniforms bit
-// for bit, the same normals to the last bits of the math library; the particle pairs' draws
-// (kernels/particle_filter/particle_draws.hpp), in fp64 and in the `mixed` precision's fp32; and the truths' member
-// pairs (an odd count's last normal: truth_normals).
+// that an AVX2 host draws four at a time) against Random123's (kernels/rng.hpp's host blocks; a GPU's are
+// tests/test_rng.cpp's): the same uniforms bit for bit, the same normals to the last bits of the math library; the
+// particle pairs' draws (kernels/particle_filter/particle_draws.hpp), in fp64 and in the `mixed` precision's fp32; and
+// the truths' member pairs (an odd count's last normal: truth_normals).
 #include "kernels/for_each_member.hpp"
 #include "kernels/particle_filter/particle_draws.hpp"
 

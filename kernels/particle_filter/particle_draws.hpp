@@ -4,7 +4,7 @@
 // even particle, the sine normal to the odd one), and a model with an exact transition sampler takes block
 // i = K (after the K normals) for one uniform each. So one Philox block, one log and one square root serve two
 // particles: the GPU step is bound by instruction issue, and Box-Muller with one normal per block was a
-// quarter of it (perf/particle_filter.md). A GPU thread draws its pair's blocks with Random123's Philox
+// quarter of it (perf/particle_filter.md). A GPU thread draws its pair's blocks with rng.hpp's Philox
 // (pair_normals); the host draws a block's or a chunk's lanes at once with the host's Philox
 // (simd::uniform_pair_lanes, the same uniforms bit for bit: tests/test_particle_random.cpp) and then runs
 // Box-Muller over them in SIMD loops (draw_block_lanes, draw_pair_lanes). With `Fp32` (the `mixed` precision) the

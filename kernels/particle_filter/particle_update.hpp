@@ -150,8 +150,8 @@ KOKKOS_INLINE_FUNCTION std::uint32_t particle_draw_step(const ParticleStepData<M
   return Initialize ? 0 : d.step;
 }
 
-/// The draws of particles 2 pair (z0, u0) and 2 pair + 1 (z1, u1) of `member` at `step`, from Random123's Philox
-/// (the team kernels; the host kernel draws a block's lanes at once with simd::uniform_pair_lanes, the same bits);
+/// The draws of particles 2 pair (z0, u0) and 2 pair + 1 (z1, u1) of `member` at `step`, from Philox (philox_block:
+/// the team kernels; the host kernel draws a block's lanes at once with simd::uniform_pair_lanes, the same bits);
 /// normals in float with `fp32` (ParticleStepData::float_normals, the same for every thread: no divergence).
 template <class Model, bool Initialize>
 KOKKOS_INLINE_FUNCTION void draw_particle_pair(const RngKey& key, int member, int pair, std::uint32_t step, bool fp32,
@@ -184,6 +184,16 @@ KOKKOS_INLINE_FUNCTION typename Model::Control particle_control(const ParticleSt
     if (d.control.extent(0) > 0) return load<Model::control_dim>(d.control, member);
   }
   return Model::Control::zero();
+}
+
+/// l, or -inf where l or a component of x is not finite: a particle that left the numbers. `&`, not `&&`: no branch, so
+/// GCC can vectorize the host's loops.
+template <class S, int N>
+KOKKOS_INLINE_FUNCTION S finite_or_dead(const S l, const Vec<N, S>& x) {
+  bool finite = math::is_finite(l);
+  KUSHNER_UNROLL_FULLY
+  for (int i = 0; i < N; ++i) finite = finite & math::is_finite(x[i]);
+  return finite ? l : -static_cast<S>(math::infinity());
 }
 
 /// A particle's new state x and log-weight l as the bank stores them (stored_value, kernels/bank.hpp); returns l, or
@@ -244,7 +254,9 @@ KOKKOS_FORCEINLINE_FUNCTION S continuous_time_step(
   }
   const Vec<Model::obs_dim, S> h = d.model.observation(t + d.dt, xs);
   const S increment = dot(h, convert<S>(vinv_dy)) - d.template half_dt_as<S>() * dot(h, convert<S>(precision) * h);
-  return static_cast<S>(log_weight - log_normalizer) + increment;
+  // In S, the normalizer rounded alone: it is the member's, so its rounding moves all of the member's log-weights
+  // alike, which the normalization takes back; a float step spends no conversions on the subtraction.
+  return static_cast<S>(log_weight) - static_cast<S>(log_normalizer) + increment;
 }
 
 /// update_particle before its results are rounded to the bank's storage.
@@ -259,12 +271,8 @@ KOKKOS_INLINE_FUNCTION double update_particle_unrounded(
     return 0.0;
   } else if constexpr (Model::discrete_time) {
     x = d.model.transition(t, x, control) + d.model.process_noise(z, u);
-    const double l =
-        log_weight - log_normalizer + d.model.observation_log_density(vinv_dy - d.model.observation(t + 1.0, x));
-    bool finite = math::is_finite(l);
-    KUSHNER_UNROLL_FULLY
-    for (int i = 0; i < n; ++i) finite = finite & math::is_finite(x[i]);
-    return finite ? l : -math::infinity();
+    return finite_or_dead(
+        log_weight - log_normalizer + d.model.observation_log_density(vinv_dy - d.model.observation(t + 1.0, x)), x);
   } else {
     // In S: float where fp32 stores floats and the model's dynamics take float (particle_step_scalar), else double
     // (every convert<double> below is then a copy, and the expressions are those of the double step).
@@ -273,10 +281,7 @@ KOKKOS_INLINE_FUNCTION double update_particle_unrounded(
     const double l =
         continuous_time_step<FloatIncrements>(d, t, precision, z, u, log_weight, log_normalizer, vinv_dy, control, xs);
     x = convert<double>(xs);
-    bool finite = math::is_finite(l);
-    KUSHNER_UNROLL_FULLY
-    for (int i = 0; i < n; ++i) finite = finite & math::is_finite(x[i]);  // `&`: no branch, so GCC can vectorize
-    return finite ? l : -math::infinity();
+    return finite_or_dead(l, x);
   }
 }
 }  // namespace detail
@@ -320,12 +325,9 @@ KOKKOS_INLINE_FUNCTION float update_particle(const ParticleStepData<Model, MemSp
     x = convert<float>(xd);
     return static_cast<float>(l);
   } else {
-    const float l = detail::continuous_time_step<FloatIncrements>(d, t, precision, z, u, log_weight, log_normalizer,
-                                                                  vinv_dy, control, x);
-    bool finite = math::is_finite(l);
-    KUSHNER_UNROLL_FULLY
-    for (int i = 0; i < Model::state_dim; ++i) finite = finite & math::is_finite(x[i]);
-    return finite ? l : -static_cast<float>(math::infinity());
+    return finite_or_dead(detail::continuous_time_step<FloatIncrements>(d, t, precision, z, u, log_weight,
+                                                                        log_normalizer, vinv_dy, control, x),
+                          x);
   }
 }
 
