@@ -540,8 +540,8 @@ TYPED_TEST(WeightExp, IsWithinItsBoundOfExp) {
     int exponent;
     std::frexp(static_cast<float>(exact), &exponent);
     const double ulps = std::abs(e[i] - exact) / std::ldexp(1.0, exponent - 24);
-    if (ulps / (2.0 + std::floor(1.173 * std::abs(x[i]))) > worst_cuda)
-      worst_cuda = ulps / (2.0 + std::floor(1.173 * std::abs(x[i]))), worst_cuda_x = x[i];
+    const double over_cuda = ulps / (2.0 + std::floor(1.173 * std::abs(x[i])));
+    if (over_cuda > worst_cuda) worst_cuda = over_cuda, worst_cuda_x = x[i];
   }
   EXPECT_EQ(outside, 0) << "largest error over its bound " << worst << " at " << worst_x;
   EXPECT_EQ(e.back(), 0.0f);

@@ -1,7 +1,7 @@
 #pragma once
 // The host's Philox4x32-10: the uniforms of a run of SIMD lanes' blocks (uniform_pair_lanes), the same counters and
 // the same 52-bit uniforms as kernels/rng.hpp, bit for bit (tests/test_particle_random.cpp); a GPU takes rng.hpp's
-// rounds (philox4x32_10), with its 32-bit multiply-high.
+// rounds (philox4x32_10), one 32 x 32 -> 64-bit multiply per product.
 //
 // On an x86-64 host with AVX2 but not AVX-512DQ, four lanes per 256-bit vector, written with AVX2's intrinsics: each
 // round's two 32 x 32 -> 64-bit products are one vpmuludq each. GCC's vectorization of the scalar rounds below
