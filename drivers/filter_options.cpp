@@ -67,8 +67,8 @@ void add_filter_options(CLI::App& app, FilterOptions& o) {
          "--precision", o.precision,
          "PF arithmetic: fp64; mixed (normals drawn in fp32, each step's increment computed in fp32 where the "
          "model's dynamics take it (sine, linear, ou); particles, weights and sums in fp64; faster on GPUs); or fp32 "
-         "(mixed's normals, particles and log-weights stored in fp32: about half the "
-         "memory per particle; each step computed in fp32 where the model's dynamics take it (sine, linear, ou), "
+         "(normals in fp32, two steps' from one random block; particles and log-weights stored in fp32: about half "
+         "the memory per particle; each step computed in fp32 where the model's dynamics take it (sine, linear, ou), "
          "else in fp64; sums in fp64)")
       ->capture_default_str();
   app.add_option("--step-pairs", o.step_pairs,

@@ -13,7 +13,8 @@
 // The fp32 variant (the particle filter's `mixed` and `fp32` precisions) takes 23-bit uniforms from the same blocks'
 // high words (the top bits of the 52-bit ones) and runs Box-Muller in float (on a GPU by its special-function unit):
 // the same normals to about 1e-7 on a host and about 1e-6 on a GPU, with the radius cut at sqrt(48 ln 2) = 5.77
-// (probability 2^-24 beyond it).
+// (probability 2^-24 beyond it). The `fp32` precision's steps take the low words too: two steps' normals from one
+// block (fp32_pair_normals, kernels/particle_filter/particle_draws.hpp).
 // The truths take component i of their N normals from block i / 2 (normal_vector; a continuous-time truth's
 // observation and process normals are one vector of the process-noise stream, and where their count is odd two
 // neighbouring members share the last one's block: truth_normals);
@@ -140,12 +141,14 @@ KOKKOS_INLINE_FUNCTION void uniform_pair(const RngKey& key, const Counter& c, do
   u1 = uniform_open(r.v[2], r.v[3]);
 }
 
-/// Two independent fp32 uniforms in (0, 1) from one Philox block: uniform_open_fp32 of its high words (the
-/// `mixed` precision's; simd::uniform_pair_fp32 gives the same floats).
-KOKKOS_INLINE_FUNCTION void uniform_pair_fp32(const RngKey& key, const Counter& c, float& u0, float& u1) {
+/// Two independent fp32 uniforms in (0, 1) from one Philox block: uniform_open_fp32 of its high words, words 0 and 2
+/// (the `mixed` precision's), or of its low words 1 and 3 with `low_words` (the `fp32` precision's odd steps:
+/// fp32_pair_normals); simd::uniform_pair_fp32 gives the same floats.
+KOKKOS_INLINE_FUNCTION void uniform_pair_fp32(const RngKey& key, const Counter& c, float& u0, float& u1,
+                                              const bool low_words = false) {
   const r123array4x32 r = philox_block(key, c);
-  u0 = uniform_open_fp32(r.v[0]);
-  u1 = uniform_open_fp32(r.v[2]);
+  u0 = uniform_open_fp32(low_words ? r.v[1] : r.v[0]);
+  u1 = uniform_open_fp32(low_words ? r.v[3] : r.v[2]);
 }
 
 struct NormalPair {

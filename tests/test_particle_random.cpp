@@ -1,8 +1,9 @@
 // The host's Philox (kernels/particle_filter/simd_random.hpp: the scalar rounds GCC vectorizes, and the runs of lanes
 // that an AVX2 host draws four at a time) against Random123's (kernels/rng.hpp's host blocks; a GPU's are
 // tests/test_rng.cpp's): the same uniforms bit for bit, the same normals to the last bits of the math library; the
-// particle pairs' draws (kernels/particle_filter/particle_draws.hpp), in fp64 and in the `mixed` precision's fp32; and
-// the truths' member pairs (an odd count's last normal: truth_normals).
+// particle pairs' draws (kernels/particle_filter/particle_draws.hpp), in fp64, in the `mixed` precision's fp32 and in
+// the `fp32` precision's steps (two steps from one block); and the truths' member pairs (an odd count's last normal:
+// truth_normals).
 #include "kernels/for_each_member.hpp"
 #include "kernels/particle_filter/particle_draws.hpp"
 
@@ -37,8 +38,9 @@ TEST(SimdPhilox, UniformsBitIdenticalToRandom123) {
 constexpr int lane_counts[] = {1, 2, 3, 4, 5, 7, 8, 9, 11, 12, 13, 16, 31, 64, 65, 100, 128};
 
 TEST(SimdPhilox, LaneRunsBitIdenticalToRandom123) {
-  // uniform_pair_lanes and uniform_pair_fp32_lanes against Random123 lane by lane: each field as the lanes' stride
-  // (members, particles, member pairs, steps), counters that wrap past 2^32 within a run, a process's first member.
+  // uniform_pair_lanes and uniform_pair_fp32_lanes (high words and low words) against Random123 lane by lane: each
+  // field as the lanes' stride (members, particles, member pairs, steps), counters that wrap past 2^32 within a run, a
+  // process's first member.
   const Counter strides[] = {{1, 0, 0, 0}, {0, 1, 0, 0}, {2, 0, 0, 0}, {0, 0, 3, 0}, {0, 0, 0, 1}};
   const Counter firsts[] = {{0, 0, 0, 0}, {5, 255, 999999, 2}, {0xfffffff0u, 0xffffffc0u, 7, 0xfffffffeu}};
   for (const std::uint32_t first_member : {0u, 1u, 0xfffffff9u})
@@ -48,19 +50,23 @@ TEST(SimdPhilox, LaneRunsBitIdenticalToRandom123) {
           const RngKey key{Seed(20261205, first_member), Stream::particle_noise};
           const simd::LaneCounters c{first, stride};
           double u0[128], u1[128];
-          float f0[128], f1[128];
+          float f0[128], f1[128], h0[128], h1[128];
           simd::uniform_pair_lanes(key, c, lanes, u0, u1);
           simd::uniform_pair_fp32_lanes(key, c, lanes, f0, f1);
+          simd::uniform_pair_fp32_lanes(key, c, lanes, h0, h1, true);
           for (int j = 0; j < lanes; ++j) {
             double a0, a1;
-            float g0, g1;
+            float g0, g1, l0, l1;
             uniform_pair(key, c(j), a0, a1);
             uniform_pair_fp32(key, c(j), g0, g1);
+            uniform_pair_fp32(key, c(j), l0, l1, true);
             ASSERT_EQ(u0[j], a0) << lanes << " lanes, lane " << j << ", stride " << stride.member << stride.particle
                                  << stride.step << stride.draw << ", first member " << first_member;
             ASSERT_EQ(u1[j], a1) << lanes << " lanes, lane " << j;
             ASSERT_EQ(f0[j], g0) << lanes << " lanes, lane " << j;
             ASSERT_EQ(f1[j], g1) << lanes << " lanes, lane " << j;
+            ASSERT_EQ(h0[j], l0) << lanes << " lanes, lane " << j;
+            ASSERT_EQ(h1[j], l1) << lanes << " lanes, lane " << j;
           }
         }
 }
@@ -311,6 +317,94 @@ TEST(MixedPrecisionDraws, Fp32NormalsAreUnitNormals) {
   EXPECT_LT(std::abs(soo / n - 1.0), 5.0 * std::sqrt(2.0 / n));
   EXPECT_LT(std::abs(seo / n), 5.0 / std::sqrt(n));
   EXPECT_LT(std::abs(s4 / n - 3.0), 5.0 * std::sqrt(96.0 / n));
+}
+
+/// The host's fp32 step normals (draw_fp32_pair_lanes) of `pairs` particle pairs of `member` at `step`, component 0,
+/// as NormalPairs, compiled once for every count.
+KUSHNER_SAME_CODE_FOR_ALL_CALLERS void draw_fp32_pairs_apart(const RngKey& key, const int member, const int pairs,
+                                                             const std::uint32_t step, double* const z) {
+  draw_fp32_pair_lanes(key, member, 0, pairs, step, 0, z);
+}
+std::vector<NormalPair> host_fp32_step_normals(const RngKey& key, const int member, const int pairs,
+                                               const std::uint32_t step) {
+  std::vector<double> z(2 * static_cast<std::size_t>(pairs));
+  draw_fp32_pairs_apart(key, member, pairs, step, z.data());
+  std::vector<NormalPair> out(pairs);
+  for (int k = 0; k < pairs; ++k) out[k] = {z[2 * k], z[2 * k + 1]};
+  return out;
+}
+
+TEST(Fp32StepDraws, TwoStepsShareABlockAsDocumented) {
+  // Steps 2m and 2m + 1 from block {member, pair, 2m, i}: the even step mixed's normals of it (bit for bit), the odd
+  // step the float Box-Muller of its words 1 and 3 (Random123's block, read here word by word). The two-step form (the
+  // GPU's fused pass) gives the one-step form's numbers from an even step and from an odd one, and the host's runs of
+  // lanes give them to the last bits of the float math library (libmvec's against libm's).
+  const RngKey key{20261206, Stream::particle_noise};
+  const int pairs = 300;
+  for (const std::uint32_t step : {0u, 1u, 6u, 7u, 0xfffffffeu}) {
+    const std::vector<NormalPair> lanes = host_fp32_step_normals(key, 4, pairs, step);
+    for (int pair = 0; pair < pairs; ++pair) {
+      const NormalPair z = fp32_pair_normals(key, 4, pair, step, 0);
+      const r123array4x32 block = {{4, std::uint32_t(pair), step & ~1u, 0}};
+      const r123array2x32 k = {{key.seed.value, static_cast<std::uint32_t>(key.stream)}};
+      const r123array4x32 r = philox4x32(block, k);  // Random123's block
+      const bool odd = (step & 1u) != 0;
+      const NormalPair want = box_muller_fp32(uniform_open_fp32(r.v[odd ? 1 : 0]), uniform_open_fp32(r.v[odd ? 3 : 2]));
+      ASSERT_EQ(z.z0, want.z0) << "step " << step << " pair " << pair;
+      ASSERT_EQ(z.z1, want.z1) << "step " << step << " pair " << pair;
+      if (!odd) {
+        const NormalPair mixed = pair_normals<true>(key, 4, pair, step, 0);
+        ASSERT_EQ(z.z0, mixed.z0);
+        ASSERT_EQ(z.z1, mixed.z1);
+      }
+      const double r_z = std::hypot(z.z0, z.z1);
+      ASSERT_NEAR(lanes[pair].z0, z.z0, 1e-6 * (1.0 + r_z)) << "step " << step << " pair " << pair;
+      ASSERT_NEAR(lanes[pair].z1, z.z1, 1e-6 * (1.0 + r_z)) << "step " << step << " pair " << pair;
+      if (step == 0xfffffffeu) continue;  // its next step is past the counter
+      NormalPair first, second;
+      fp32_pair_normals_two_steps(key, 4, pair, step, 0, first, second);
+      const NormalPair next = fp32_pair_normals(key, 4, pair, step + 1, 0);
+      ASSERT_EQ(first.z0, z.z0);
+      ASSERT_EQ(first.z1, z.z1);
+      ASSERT_EQ(second.z0, next.z0);
+      ASSERT_EQ(second.z1, next.z1);
+    }
+  }
+}
+
+TEST(Fp32StepDraws, TheTwoStepsOfABlockAreIndependentUnitNormals) {
+  // 2^20 pairs at steps 4 and 5 (one block each): each step's normals have mean 0, variance 1 and fourth moment 3,
+  // and every correlation between them (within a step, and across the two steps: the block's high words against its
+  // low words) is 0, within 5 standard errors (a sample variance's sqrt(2 / n), a correlation's 1 / sqrt(n), the
+  // fourth moment's sqrt(96 / n)); P(false alarm) ~ 1e-5 over the ten checks.
+  const int pairs = 1 << 20;
+  const RngKey key{17, Stream::particle_noise};
+  const std::vector<NormalPair> even = host_fp32_step_normals(key, 2, pairs, 4);
+  const std::vector<NormalPair> odd = host_fp32_step_normals(key, 2, pairs, 5);
+  const double n = pairs;
+  for (const auto* step : {&even, &odd}) {
+    double s1 = 0.0, see = 0.0, soo = 0.0, seo = 0.0, s4 = 0.0;
+    for (const NormalPair& z : *step) {
+      s1 += z.z0 + z.z1;
+      see += z.z0 * z.z0;
+      soo += z.z1 * z.z1;
+      seo += z.z0 * z.z1;
+      s4 += z.z1 * z.z1 * z.z1 * z.z1;
+    }
+    EXPECT_LT(std::abs(s1 / (2 * n)), 5.0 / std::sqrt(2 * n));
+    EXPECT_LT(std::abs(see / n - 1.0), 5.0 * std::sqrt(2.0 / n));
+    EXPECT_LT(std::abs(soo / n - 1.0), 5.0 * std::sqrt(2.0 / n));
+    EXPECT_LT(std::abs(seo / n), 5.0 / std::sqrt(n));
+    EXPECT_LT(std::abs(s4 / n - 3.0), 5.0 * std::sqrt(96.0 / n));
+  }
+  double c00 = 0.0, c11 = 0.0, c01 = 0.0, c10 = 0.0;
+  for (int k = 0; k < pairs; ++k) {
+    c00 += even[k].z0 * odd[k].z0;
+    c11 += even[k].z1 * odd[k].z1;
+    c01 += even[k].z0 * odd[k].z1;
+    c10 += even[k].z1 * odd[k].z0;
+  }
+  for (const double c : {c00, c11, c01, c10}) EXPECT_LT(std::abs(c / n), 5.0 / std::sqrt(n));
 }
 
 }  // namespace

@@ -1,4 +1,5 @@
 // Philox normals and uniforms: moments, Kolmogorov-Smirnov against the exact laws, and independence of streams.
+#include "kernels/particle_filter/particle_draws.hpp"
 #include "kernels/rng.hpp"
 #include "tests/test_spaces.hpp"
 
@@ -181,6 +182,67 @@ TYPED_TEST(PhiloxNormals, FloatBoxMullerIsWithinItsBoundOfTheDoubleOne) {
   EXPECT_EQ(outside, 0) << "largest error over its bound " << worst;
   expect_standard_normal_moments(fast_normals);
   std::cout << "largest error over its bound " << worst << "\n";
+}
+
+/// The `fp32` precision's step draws of particle pairs [0, pairs) on ExecSpace, as its fused pass takes them
+/// (fp32_pair_normals_two_steps): z(pair, t, 0..3) the normals of steps first_step + t and first_step + t + 1 (member
+/// 3, component 1); the count of pairs whose one-step form (fp32_pair_normals, the fused pass's redo) differs.
+template <class ExecSpace>
+int draw_fp32_step_pairs(int pairs, std::uint32_t first_step,
+                         Kokkos::View<double* [2][4], Kokkos::LayoutRight, Kokkos::HostSpace>& z) {
+  using Memory = typename ExecSpace::memory_space;
+  const RngKey key{seed, Stream::particle_noise};
+  Kokkos::View<double* [2][4], Kokkos::LayoutRight, Memory> normals("normals", pairs);
+  Kokkos::View<int*, Memory> one_step_differs("one_step_differs", 1);
+  Kokkos::parallel_for(
+      "test::fp32_step_draws", Kokkos::RangePolicy<ExecSpace>(0, pairs), KOKKOS_LAMBDA(const int pair) {
+        for (int t = 0; t < 2; ++t) {
+          NormalPair first, second;
+          fp32_pair_normals_two_steps(key, 3, pair, first_step + t, 1, first, second);
+          const NormalPair a = fp32_pair_normals(key, 3, pair, first_step + t, 1);
+          const NormalPair b = fp32_pair_normals(key, 3, pair, first_step + t + 1, 1);
+          if (a.z0 != first.z0 || a.z1 != first.z1 || b.z0 != second.z0 || b.z1 != second.z1)
+            Kokkos::atomic_add(&one_step_differs(0), 1);
+          normals(pair, t, 0) = first.z0;
+          normals(pair, t, 1) = first.z1;
+          normals(pair, t, 2) = second.z0;
+          normals(pair, t, 3) = second.z1;
+        }
+      });
+  z = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), normals);
+  return Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), one_step_differs)(0);
+}
+
+/// The fp32 step draws on the backend from an even step (one block) and an odd one (two) against the words the host
+/// reads from Random123's blocks: steps 2m and 2m + 1 from block {member, pair, 2m, i}, words 0, 2 and 1, 3. Each
+/// normal within FloatBoxMuller's bound of the double Box-Muller of its float uniforms (a wrong word would be off by
+/// about 1); the one-step form gives the same bits on the backend.
+TYPED_TEST(PhiloxNormals, Fp32StepsTakeTheirBlocksWords) {
+  constexpr int pairs = 1 << 16;
+  constexpr std::uint32_t first_step = 6;
+  Kokkos::View<double* [2][4], Kokkos::LayoutRight, Kokkos::HostSpace> z;
+  EXPECT_EQ(draw_fp32_step_pairs<TypeParam>(pairs, first_step, z), 0);
+  int outside = 0;
+  double worst = 0.0;
+  for (int pair = 0; pair < pairs; ++pair)
+    for (int t = 0; t < 2; ++t)
+      for (int s = 0; s < 2; ++s) {
+        const std::uint32_t step = first_step + t + s;
+        const r123array4x32 block = {{3, std::uint32_t(pair), step & ~1u, 1}};
+        const r123array2x32 k = {{seed, std::uint32_t(Stream::particle_noise)}};
+        const r123array4x32 r = philox4x32(block, k);
+        const int w = step & 1u;
+        const NormalPair exact = box_muller(uniform_open_fp32(r.v[w]), uniform_open_fp32(r.v[w + 2]));
+        const double radius = std::hypot(exact.z0, exact.z1);
+        const double bound = 2.0 * (std::min(std::sqrt(3.3e-7), 1.65e-7 / radius) + 1.2e-6 * radius) + 1e-7;
+        for (const auto& [got, want] :
+             {std::pair{z(pair, t, 2 * s), exact.z0}, std::pair{z(pair, t, 2 * s + 1), exact.z1}}) {
+          outside += !(std::abs(got - want) <= bound);
+          worst = std::max(worst, std::abs(got - want) / bound);
+        }
+      }
+  EXPECT_EQ(outside, 0) << "largest error over its bound " << worst;
+  std::cout << "fp32 steps: largest error over its bound " << worst << "\n";
 }
 
 TEST(PhiloxStreams, DistinctStreamsShareNoBlockAndAreUncorrelated) {

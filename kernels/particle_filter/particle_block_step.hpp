@@ -14,11 +14,17 @@
 
 namespace kushner {
 
-/// The normals of `pairs` particle pairs from first_pair on, component i in z[i][particle]; in float with Fp32.
-template <bool Fp32, int K>
+/// The normals of `pairs` particle pairs from first_pair on, component i in z[i][particle]; in float with Fp32, and
+/// fp32_pair_normals with Fp32Steps.
+template <bool Fp32, bool Fp32Steps, int K>
 inline void draw_block_normals(const RngKey& key, int member, int first_pair, int pairs, std::uint32_t step,
                                double (&z)[K][host_particle_block]) {
-  for (int i = 0; i < K; ++i) draw_pair_lanes<Fp32>(key, particle_pair_lanes(member, first_pair, step, i), pairs, z[i]);
+  for (int i = 0; i < K; ++i) {
+    if constexpr (Fp32Steps)
+      draw_fp32_pair_lanes(key, member, first_pair, pairs, step, i, z[i]);
+    else
+      draw_pair_lanes<Fp32>(key, particle_pair_lanes(member, first_pair, step, i), pairs, z[i]);
+  }
 }
 
 /// The host kernel's work for one block: a function of the model and the data only (not of the execution
@@ -62,10 +68,12 @@ KUSHNER_SAME_CODE_FOR_ALL_CALLERS void particle_block_host(const ParticleStepDat
   const std::uint32_t step = particle_draw_step<Initialize>(d);
   const int first_pair = begin / 2;   // blocks start at even particles
   const int pairs = (count + 1) / 2;  // an odd count's last particle is the even half of its pair
-  if (d.float_normals())
-    draw_block_normals<true, K>(key, member, first_pair, pairs, step, z);
+  if constexpr (fp32_step_draws<Real, Initialize>)
+    draw_block_normals<true, true, K>(key, member, first_pair, pairs, step, z);
+  else if (d.float_normals())
+    draw_block_normals<true, false, K>(key, member, first_pair, pairs, step, z);
   else
-    draw_block_normals<false, K>(key, member, first_pair, pairs, step, z);
+    draw_block_normals<false, false, K>(key, member, first_pair, pairs, step, z);
   if constexpr (draws_uniform<Model, Initialize>) {
     double u0[B / 2], u1[B / 2];
     simd::uniform_pair_lanes(key, particle_pair_lanes(member, first_pair, step, K), pairs, u0, u1);

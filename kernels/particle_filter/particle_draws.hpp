@@ -9,7 +9,8 @@
 // (simd::uniform_pair_lanes, the same uniforms bit for bit: tests/test_particle_random.cpp) and then runs
 // Box-Muller over them in SIMD loops (draw_block_lanes, draw_pair_lanes). With `Fp32` (the `mixed` precision) the
 // normals come from the same blocks by the float Box-Muller (kernels/rng.hpp); the uniforms of exact transition
-// samplers stay fp64. The truths' and the EnKBF's host draws are here too.
+// samplers stay fp64. The `fp32` precision's steps take a block's four words as four float uniforms, so that two
+// steps share a block (fp32_pair_normals). The truths' and the EnKBF's host draws are here too.
 #include "kernels/particle_filter/simd_random.hpp"
 #include "kernels/rng.hpp"
 #include "kernels/vector_math.hpp"
@@ -81,6 +82,35 @@ KOKKOS_INLINE_FUNCTION NormalPair pair_normals(const RngKey& key, int member, in
   }
 }
 
+/// The `fp32` precision's step normals, component i of particles 2 pair (z0) and 2 pair + 1 (z1) at `step`: steps 2m
+/// and 2m + 1 share block {member, pair, 2m, i}, whose four words are four float uniforms (uniform_open_fp32 takes 23
+/// bits of a word). Step 2m takes words 0 and 2 (mixed's normals of that block), step 2m + 1 words 1 and 3. Half of
+/// mixed's Philox blocks per particle-step: on a GPU a block's rounds were 43 of the 368 SASS instructions of fp32's
+/// fused pair loop (two particles, two steps), x1.08 on an H100 (perf/particle_filter.md). fp32's initial particles
+/// are mixed's (pair_normals<true>).
+KOKKOS_INLINE_FUNCTION Counter step_pair_block(int member, int pair, std::uint32_t step, int i) {
+  return {std::uint32_t(member), std::uint32_t(pair), step & ~1u, std::uint32_t(i)};
+}
+KOKKOS_INLINE_FUNCTION NormalPair fp32_pair_normals(const RngKey& key, int member, int pair, std::uint32_t step,
+                                                    int i) {
+  float u0, u1;
+  uniform_pair_fp32(key, step_pair_block(member, pair, step, i), u0, u1, (step & 1u) != 0);
+  return box_muller_fp32(u0, u1);
+}
+
+/// fp32_pair_normals at `step` (first) and step + 1 (second): one block where `step` is even, two where it is odd.
+KOKKOS_INLINE_FUNCTION void fp32_pair_normals_two_steps(const RngKey& key, int member, int pair, std::uint32_t step,
+                                                        int i, NormalPair& first, NormalPair& second) {
+  const r123array4x32 a = philox_block(key, step_pair_block(member, pair, step, i));
+  std::uint32_t w0 = a.v[0], w1 = a.v[2], w2 = a.v[1], w3 = a.v[3];
+  if ((step & 1u) != 0) {  // the same for every particle of a pass: no divergence
+    const r123array4x32 b = philox_block(key, step_pair_block(member, pair, step + 1, i));
+    w0 = a.v[1], w1 = a.v[3], w2 = b.v[0], w3 = b.v[2];
+  }
+  first = box_muller_fp32(uniform_open_fp32(w0), uniform_open_fp32(w1));
+  second = box_muller_fp32(uniform_open_fp32(w2), uniform_open_fp32(w3));
+}
+
 /// The uniforms of particles 2 pair (u0) and 2 pair + 1 (u1) whose draws also hold K normals each.
 KOKKOS_INLINE_FUNCTION void pair_uniforms(const RngKey& key, int member, int pair, std::uint32_t step, int K,
                                           double& u0, double& u1) {
@@ -98,16 +128,17 @@ KOKKOS_INLINE_FUNCTION NormalPair box_muller_of(const double u0, const double u1
 KOKKOS_INLINE_FUNCTION NormalPair box_muller_of(const float u0, const float u1) { return box_muller_fp32(u0, u1); }
 
 /// Host: the normals of `pairs` particle pairs from lanes' blocks (particle_pair_lanes), z0 of pair k to z[2 k] and
-/// z1 to z[2 k + 1]; in float with Fp32 (pair_normals' numbers, in pieces of host_draw_piece pairs).
+/// z1 to z[2 k + 1]; in float with Fp32 (pair_normals' numbers, in pieces of host_draw_piece pairs), from the blocks'
+/// low words with `low_words`.
 template <bool Fp32>
 KUSHNER_FLATTEN void draw_pair_lanes(const RngKey& key, const simd::LaneCounters& pairs_at, const int pairs,
-                                     double* const z) {
+                                     double* const z, const bool low_words = false) {
   using Uniform = std::conditional_t<Fp32, float, double>;
   for (int first = 0; first < pairs; first += host_draw_piece) {
     const int count = pairs - first < host_draw_piece ? pairs - first : host_draw_piece;
     Uniform u0[host_draw_piece], u1[host_draw_piece];
     if constexpr (Fp32)
-      simd::uniform_pair_fp32_lanes(key, pairs_at.from(first), count, u0, u1);
+      simd::uniform_pair_fp32_lanes(key, pairs_at.from(first), count, u0, u1, low_words);
     else
       simd::uniform_pair_lanes(key, pairs_at.from(first), count, u0, u1);
     double* const out = z + 2 * first;
@@ -118,6 +149,13 @@ KUSHNER_FLATTEN void draw_pair_lanes(const RngKey& key, const simd::LaneCounters
       out[2 * k + 1] = pair.z1;
     }
   }
+}
+
+/// Host: fp32_pair_normals of `pairs` particle pairs of `member` from first_pair on, component i, into z as
+/// draw_pair_lanes.
+inline void draw_fp32_pair_lanes(const RngKey& key, int member, int first_pair, int pairs, std::uint32_t step, int i,
+                                 double* const z) {
+  draw_pair_lanes<true>(key, particle_pair_lanes(member, first_pair, step & ~1u, i), pairs, z, (step & 1u) != 0);
 }
 
 /// Host: member_pair_normal(key, lane, step, draw) for each lane (local member) of [begin, end) into z[lane - begin]:

@@ -13,9 +13,11 @@ namespace kushner {
 /// 6e-8 of the increment and of |x f'(x)| dt, the drift taken at x rounded to float, as much as the float normal's
 /// rounding moves it), and the GPU kernels' weights exp(l - shift) for the moments in float (math::weight_exp). A GPU's
 /// float log, sine, Box-Muller and exp cost a fraction of the fp64 ones in a step bound by the card's power cap
-/// (H200, sine, `step_pair`: 1.50e11 particle-steps/s against fp64's 8.3e10; perf/particle_filter.md). fp32: mixed's
-/// normals, and the particles and their log-weights (and, while resampling, cumulative weights) stored in float: half
-/// the bytes moved per particle-step, and about half the memory per particle (the ancestor index stays an int). A
+/// (H200, sine, `step_pair`: 1.50e11 particle-steps/s against fp64's 8.3e10; perf/particle_filter.md). fp32: the
+/// particles and their log-weights (and, while resampling, cumulative weights) stored in float: half the bytes moved
+/// per particle-step, and about half the memory per particle (the ancestor index stays an int). Its normals are float
+/// ones as mixed's, but two steps take theirs from one Philox block's four words (fp32_pair_normals: the even step's
+/// are mixed's, the odd step's its own), half the blocks per particle-step; its initial particles are mixed's. A
 /// particle's Euler-Maruyama step is computed in float where the model's dynamics take float (particle_step_scalar),
 /// otherwise in double from the stored values, and rounded once where it is stored (the GPU kernels hold such
 /// particles in float from load to store); the GPU kernels take the weights' exp in float (math::weight_exp); the

@@ -64,14 +64,42 @@ KOKKOS_INLINE_FUNCTION void load_particle_batch(const Real* xm, const Real* lwm,
 }
 
 /// The batch's draws at `step`.
-template <class Model, bool Initialize>
+template <class Model, bool Initialize, bool Fp32Steps = false>
 KOKKOS_INLINE_FUNCTION void draw_particle_batch(const RngKey& key, int member, int base, int threads,
                                                 std::uint32_t step, bool fp32,
                                                 Vec<particle_draw_dim<Model, Initialize>>* z, double* u) {
   KUSHNER_DEVICE_UNROLL
   for (int b = 0; b < device_pairs_per_batch; ++b)
-    draw_particle_pair<Model, Initialize>(key, member, base + b * threads, step, fp32, z[2 * b], z[2 * b + 1], u[2 * b],
-                                          u[2 * b + 1]);
+    draw_particle_pair<Model, Initialize, Fp32Steps>(key, member, base + b * threads, step, fp32, z[2 * b],
+                                                     z[2 * b + 1], u[2 * b], u[2 * b + 1]);
+}
+
+/// The `fp32` precision's draws of the batch at `step` (z[0], u[0]) and step + 1 (z[1], u[1]): draw_particle_batch's
+/// numbers, with the normals of both steps from one block where `step` is even (fp32_pair_normals_two_steps).
+template <class Model>
+KOKKOS_INLINE_FUNCTION void draw_fp32_batch_two_steps(
+    const RngKey& key, int member, int base, int threads, std::uint32_t step,
+    Vec<particle_draw_dim<Model, false>> (*z)[2 * device_pairs_per_batch], double (*u)[2 * device_pairs_per_batch]) {
+  constexpr int K = particle_draw_dim<Model, false>;
+  KUSHNER_DEVICE_UNROLL
+  for (int b = 0; b < device_pairs_per_batch; ++b) {
+    const int pair = base + b * threads;
+    KUSHNER_DEVICE_UNROLL
+    for (int i = 0; i < K; ++i) {
+      NormalPair first, second;
+      fp32_pair_normals_two_steps(key, member, pair, step, i, first, second);
+      z[0][2 * b][i] = first.z0;
+      z[0][2 * b + 1][i] = first.z1;
+      z[1][2 * b][i] = second.z0;
+      z[1][2 * b + 1][i] = second.z1;
+    }
+    KUSHNER_DEVICE_UNROLL
+    for (int s = 0; s < 2; ++s) {
+      u[s][2 * b] = u[s][2 * b + 1] = 0.0;
+      if constexpr (draws_uniform<Model, false>)
+        pair_uniforms(key, member, pair, step + s, K, u[s][2 * b], u[s][2 * b + 1]);
+    }
+  }
 }
 
 /// Adds a particle of log-weight l - shift (`shifted`, a float where the kernel holds its particles in float); weight

@@ -24,6 +24,7 @@ struct ParticleTeamPairStep {
   static constexpr int n = Model::state_dim, p = Model::obs_dim;
   static_assert(!Mixed || has_mixed_increments<Model, Real>, "mixed's own kernel");
   static constexpr bool float_exp = std::is_same_v<Real, float> || Mixed;  // add_shifted_particle
+  static constexpr bool fp32_steps = fp32_step_draws<Real, false>;
   ParticleStepData<Model, MemSpace, Real> d;       // step k: its inputs, increments and partials
   ParticleSecondStep<Model, MemSpace, Real> next;  // step k + 1: its outputs, increments and partials
   // No control: a closed loop's second control depends on the first step's posterior (step_pair refuses one).
@@ -96,16 +97,20 @@ struct ParticleTeamPairStep {
       Vec<n, S> x[B];  // fp32's float steps hold their particles in float
       S lw[B];
       load_particle_batch<n, false>(xm, lwm, stride, base, c.threads, c.end, x, lw);
+      Vec<K> z[2][B];  // fp32 draws both steps' at once (one block for both where d.step is even), others a step's
+      double u[2][B];
       KUSHNER_DEVICE_UNROLL
       for (int s = 0; s < 2; ++s) {
-        Vec<K> z[B];
-        double u[B];
-        draw_particle_batch<Model, false>(key, member, base, c.threads, d.step + s, float_normals(), z, u);
+        if constexpr (fp32_steps) {
+          if (s == 0) draw_fp32_batch_two_steps<Model>(key, member, base, c.threads, d.step, z, u);
+        } else {
+          draw_particle_batch<Model, false>(key, member, base, c.threads, d.step + s, float_normals(), z[s], u[s]);
+        }
         KUSHNER_DEVICE_UNROLL
         for (int k = 0; k < B; ++k) {
           const int j = batch_particle(base, k, c.threads);
           if (j >= c.end) continue;
-          const S l = update_particle<false, Mixed>(d, step_time(s), precision<S>(s), z[k], u[k], lw[k],
+          const S l = update_particle<false, Mixed>(d, step_time(s), precision<S>(s), z[s][k], u[s][k], lw[k],
                                                     s == 0 ? log_normalizer : 0.0, vinv_dy_s[s], uncontrolled(), x[k]);
           if (s == 1) {
             KUSHNER_DEVICE_UNROLL
@@ -132,7 +137,7 @@ struct ParticleTeamPairStep {
     for (int pair = c.begin / 2 + c.rank; pair < (c.end + 1) / 2; pair += c.threads) {
       Vec<K> z[2];
       double u[2];
-      draw_particle_pair<Model, false>(key, member, pair, d.step, float_normals(), z[0], z[1], u[0], u[1]);
+      draw_particle_pair<Model, false, fp32_steps>(key, member, pair, d.step, float_normals(), z[0], z[1], u[0], u[1]);
       for (int k = 0; k < 2; ++k) {
         const int j = 2 * pair + k;
         if (j >= c.end) continue;

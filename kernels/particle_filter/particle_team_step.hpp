@@ -80,7 +80,8 @@ struct ParticleTeamStep {
       load_particle_batch<n, Initialize>(xm, lwm, stride, base, c.threads, c.end, x, lw);
       Vec<K> z[B];
       double u[B];
-      draw_particle_batch<Model, Initialize>(key, member, base, c.threads, step, float_normals(), z, u);
+      draw_particle_batch<Model, Initialize, fp32_step_draws<Real, Initialize>>(key, member, base, c.threads, step,
+                                                                                float_normals(), z, u);
       KUSHNER_DEVICE_UNROLL
       for (int k = 0; k < B; ++k) {
         const int j = batch_particle(base, k, c.threads);

@@ -150,18 +150,27 @@ KOKKOS_INLINE_FUNCTION std::uint32_t particle_draw_step(const ParticleStepData<M
   return Initialize ? 0 : d.step;
 }
 
+/// Whether a step's normals are the `fp32` precision's (fp32_pair_normals: two steps share a Philox block): those of
+/// a bank that stores its particles in float, but not its initial particles (mixed's).
+template <class Real, bool Initialize>
+constexpr bool fp32_step_draws = std::is_same_v<Real, float> && !Initialize;
+
 /// The draws of particles 2 pair (z0, u0) and 2 pair + 1 (z1, u1) of `member` at `step`, from Philox (philox_block:
 /// the team kernels; the host kernel draws a block's lanes at once with simd::uniform_pair_lanes, the same bits);
-/// normals in float with `fp32` (ParticleStepData::float_normals, the same for every thread: no divergence).
-template <class Model, bool Initialize>
+/// normals in float with `fp32` (ParticleStepData::float_normals, the same for every thread: no divergence), and
+/// fp32_pair_normals with Fp32Steps (fp32_step_draws).
+template <class Model, bool Initialize, bool Fp32Steps = false>
 KOKKOS_INLINE_FUNCTION void draw_particle_pair(const RngKey& key, int member, int pair, std::uint32_t step, bool fp32,
                                                Vec<particle_draw_dim<Model, Initialize>>& z0,
                                                Vec<particle_draw_dim<Model, Initialize>>& z1, double& u0, double& u1) {
   constexpr int K = particle_draw_dim<Model, Initialize>;
   KUSHNER_DEVICE_UNROLL
   for (int i = 0; i < K; ++i) {
-    const NormalPair zi =
-        fp32 ? pair_normals<true>(key, member, pair, step, i) : pair_normals(key, member, pair, step, i);
+    NormalPair zi;
+    if constexpr (Fp32Steps)
+      zi = fp32_pair_normals(key, member, pair, step, i);
+    else
+      zi = fp32 ? pair_normals<true>(key, member, pair, step, i) : pair_normals(key, member, pair, step, i);
     z0[i] = zi.z0;
     z1[i] = zi.z1;
   }

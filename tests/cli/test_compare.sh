@@ -82,9 +82,10 @@ assert abs(f["EXACT"]["rmse_truth"] - f["PF"]["rmse_truth"]) < 0.05, (f["EXACT"]
 assert f["PF"]["estimator"]["precision"] == "fp64", f["PF"]
 PY
 # The coarser precisions, each against the next finer one's run (mixed against fp64's e1, fp32 against mixed's):
-# recorded, and as close to the grid filter as fp64's particle filter. mixed draws the same Philox normals in fp32,
-# fp32 also stores the particles and log-weights in float: the two particle filters' errors agree far below their
-# noise floor, but not to the bit.
+# recorded, and as close to the grid filter as fp64's particle filter. mixed draws the same Philox normals in fp32:
+# the two particle filters' errors agree far below their noise floor (1e-3 against about 0.02), but not to the bit.
+# fp32 also stores the particles and log-weights in float and takes its odd steps' normals from other words of the
+# blocks (two steps from one block): its error differs from mixed's by Monte Carlo error, within the noise floor.
 finer=e1
 for precision in mixed fp32; do
   run_kushner "$work/m" filter --model sine --filters QLF,PF,EXACT --members 8 --particles 2048 --T 0.5 --dt 1e-2 \
@@ -95,7 +96,8 @@ import json, sys
 coarse, fine = (json.load(open(p))["filters"] for p in sys.argv[1:3])
 assert coarse["PF"]["estimator"]["precision"] == sys.argv[3], coarse["PF"]
 assert coarse["EXACT"]["rmse_ref"] < 0.05, coarse["EXACT"]
-assert abs(coarse["PF"]["rmse_truth"] - fine["PF"]["rmse_truth"]) < 1e-3, (coarse["PF"], fine["PF"])
+tolerance = coarse["PF"]["estimator"]["noise_floor"] if sys.argv[3] == "fp32" else 1e-3
+assert abs(coarse["PF"]["rmse_truth"] - fine["PF"]["rmse_truth"]) < tolerance, (coarse["PF"], fine["PF"])
 assert coarse["PF"]["rmse_truth"] != fine["PF"]["rmse_truth"], "the same bits as the finer precision"
 PY
   echo "ok: --precision $precision"
