@@ -63,6 +63,18 @@ KOKKOS_INLINE_FUNCTION void load_particle_batch(const Real* xm, const Real* lwm,
   }
 }
 
+/// p, as a value the GPU's compiler cannot recompute: it keeps the pointer in registers. Without this nvcc recomputed a
+/// member's column pointers from the views' data pointers and strides (kernel parameters) at every load and store of
+/// fp32's fused pair loop: 369 SASS instructions, 325 with it, and fp32's `step_pair` x1.044 on an H100, though the
+/// loads and stores become generic ones (LD, ST) where they were global (perf/particle_filter.md).
+template <class T>
+KOKKOS_FORCEINLINE_FUNCTION T* held_in_registers(T* p) {
+#if KUSHNER_CUDA_DEVICE_PASS
+  asm("" : "+l"(p));
+#endif
+  return p;
+}
+
 /// The batch's draws at `step`.
 template <class Model, bool Initialize, bool Fp32Steps = false>
 KOKKOS_INLINE_FUNCTION void draw_particle_batch(const RngKey& key, int member, int base, int threads,

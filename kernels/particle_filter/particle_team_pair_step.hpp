@@ -85,10 +85,10 @@ struct ParticleTeamPairStep {
     constexpr int K = particle_draw_dim<Model, false>;
     const double log_normalizer = d.log_normalizer(member);
     S top[2] = {static_cast<S>(-math::infinity()), static_cast<S>(-math::infinity())};
-    const Real* const xm = &d.x(0, member, 0);
-    const Real* const lwm = &d.log_weight(0, member);
-    Real* const xo = &next.x(0, member, 0);
-    Real* const lwo = &next.log_weight(0, member);
+    const Real* const xm = held_in_registers(&d.x(0, member, 0));
+    const Real* const lwm = held_in_registers(&d.log_weight(0, member));
+    Real* const xo = held_in_registers(&next.x(0, member, 0));
+    Real* const lwo = held_in_registers(&next.log_weight(0, member));
     const std::size_t stride = d.x.stride_2();  // the same for next.x
     const RngKey key = particle_draw_key<false>(d);
     const Vec<p, S> vinv_dy_s[2] = {convert<S>(vinv_dy[0]), convert<S>(vinv_dy[1])};
