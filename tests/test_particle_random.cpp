@@ -53,7 +53,7 @@ TEST(SimdPhilox, LaneRunsBitIdenticalToRandom123) {
           float f0[128], f1[128], h0[128], h1[128];
           simd::uniform_pair_lanes(key, c, lanes, u0, u1);
           simd::uniform_pair_fp32_lanes(key, c, lanes, f0, f1);
-          simd::uniform_pair_fp32_lanes(key, c, lanes, h0, h1, true);
+          simd::uniform_pair_fp32_lanes<true>(key, c, lanes, h0, h1);
           for (int j = 0; j < lanes; ++j) {
             double a0, a1;
             float g0, g1, l0, l1;

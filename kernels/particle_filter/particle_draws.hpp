@@ -129,16 +129,17 @@ KOKKOS_INLINE_FUNCTION NormalPair box_muller_of(const float u0, const float u1) 
 
 /// Host: the normals of `pairs` particle pairs from lanes' blocks (particle_pair_lanes), z0 of pair k to z[2 k] and
 /// z1 to z[2 k + 1]; in float with Fp32 (pair_normals' numbers, in pieces of host_draw_piece pairs), from the blocks'
-/// low words with `low_words`.
-template <bool Fp32>
+/// low words with LowWords.
+template <bool Fp32, bool LowWords = false>
 KUSHNER_FLATTEN void draw_pair_lanes(const RngKey& key, const simd::LaneCounters& pairs_at, const int pairs,
-                                     double* const z, const bool low_words = false) {
+                                     double* const z) {
+  static_assert(Fp32 || !LowWords, "fp64's uniforms take all four words");
   using Uniform = std::conditional_t<Fp32, float, double>;
   for (int first = 0; first < pairs; first += host_draw_piece) {
     const int count = pairs - first < host_draw_piece ? pairs - first : host_draw_piece;
     Uniform u0[host_draw_piece], u1[host_draw_piece];
     if constexpr (Fp32)
-      simd::uniform_pair_fp32_lanes(key, pairs_at.from(first), count, u0, u1, low_words);
+      simd::uniform_pair_fp32_lanes<LowWords>(key, pairs_at.from(first), count, u0, u1);
     else
       simd::uniform_pair_lanes(key, pairs_at.from(first), count, u0, u1);
     double* const out = z + 2 * first;
@@ -155,7 +156,11 @@ KUSHNER_FLATTEN void draw_pair_lanes(const RngKey& key, const simd::LaneCounters
 /// draw_pair_lanes.
 inline void draw_fp32_pair_lanes(const RngKey& key, int member, int first_pair, int pairs, std::uint32_t step, int i,
                                  double* const z) {
-  draw_pair_lanes<true>(key, particle_pair_lanes(member, first_pair, step & ~1u, i), pairs, z, (step & 1u) != 0);
+  const simd::LaneCounters lanes = particle_pair_lanes(member, first_pair, step & ~1u, i);
+  if ((step & 1u) != 0)
+    draw_pair_lanes<true, true>(key, lanes, pairs, z);
+  else
+    draw_pair_lanes<true>(key, lanes, pairs, z);
 }
 
 /// Host: member_pair_normal(key, lane, step, draw) for each lane (local member) of [begin, end) into z[lane - begin]:
