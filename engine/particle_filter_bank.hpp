@@ -413,7 +413,8 @@ ParticleFilterBank<ExecSpace, Model, Real>::ParticleFilterBank(const ExecSpace& 
   constexpr bool host_memory = std::is_same<MemSpace, Kokkos::HostSpace>::value;
   KUSHNER_REQUIRE(use_team_ || host_memory, "the host block kernel needs host memory");
   team_size_ = options.team_size > 0 ? options.team_size : (host_memory ? 1 : device_particle_team);
-  const int per_thread = options.particles_per_thread > 0 ? options.particles_per_thread : device_particles_per_thread;
+  const int per_thread =
+      options.particles_per_thread > 0 ? options.particles_per_thread : device_particles_per_thread<Real>;
   // The team kernel on the host (tests) keeps 1024-particle chunks, so small tests still merge several.
   block_size_ = use_team_ ? (host_memory ? 1024 : team_size_ * per_thread) : host_particle_block;
   num_blocks_ = (num_particles + block_size_ - 1) / block_size_;

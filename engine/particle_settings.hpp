@@ -21,7 +21,7 @@ struct ParticleFilterOptions {
   ParticleInitialLaw initial_law = ParticleInitialLaw::prior;
   ParticleKernel kernel = ParticleKernel::automatic;
   int team_size = 0;             // team kernel and resampling: 0 = the backend's default
-  int particles_per_thread = 0;  // team kernel: 0 = device_particles_per_thread
+  int particles_per_thread = 0;  // team kernel: 0 = device_particles_per_thread<stored>
   ParticlePrecision precision = ParticlePrecision::fp64;
 };
 

@@ -93,10 +93,8 @@ struct ParticleTeamPairStep {
     const RngKey key = particle_draw_key<false>(d);
     const Vec<p, S> vinv_dy_s[2] = {convert<S>(vinv_dy[0]), convert<S>(vinv_dy[1])};
     const S shift_s[2] = {static_cast<S>(shift[0]), static_cast<S>(shift[1])};  // team_shift<S>: exact
-    for (int base = c.begin / 2 + c.rank; base < (c.end + 1) / 2; base += device_pairs_per_batch * c.threads) {
-      Vec<n, S> x[B];  // fp32's float steps hold their particles in float
-      S lw[B];
-      load_particle_batch<n, false>(xm, lwm, stride, base, c.threads, c.end, x, lw);
+    // fp32's float steps hold their particles in float
+    for_each_particle_batch<n, false, S>(c, xm, lwm, stride, [&](int base, Vec<n, S>* x, S* lw) {
       Vec<K> z[2][B];  // fp32 draws both steps' at once (one block for both where d.step is even), others a step's
       double u[2][B];
       KUSHNER_DEVICE_UNROLL
@@ -109,10 +107,11 @@ struct ParticleTeamPairStep {
         KUSHNER_DEVICE_UNROLL
         for (int k = 0; k < B; ++k) {
           const int j = batch_particle(base, k, c.threads);
-          if (j >= c.end) continue;
-          const S l = update_particle<false, Mixed>(d, step_time(s), precision<S>(s), z[s][k], u[s][k], lw[k],
-                                                    s == 0 ? log_normalizer : 0.0, vinv_dy_s[s], uncontrolled(), x[k]);
-          if (s == 1) {
+          const bool live = j < c.end;  // else stepped from zeros and dropped (for_each_particle_batch)
+          S l = update_particle<false, Mixed>(d, step_time(s), precision<S>(s), z[s][k], u[s][k], lw[k],
+                                              s == 0 ? log_normalizer : 0.0, vinv_dy_s[s], uncontrolled(), x[k]);
+          if (!live) l = static_cast<S>(-math::infinity());
+          if (s == 1 && live) {
             KUSHNER_DEVICE_UNROLL
             for (int i = 0; i < n; ++i) xo[j + i * stride] = static_cast<Real>(x[k][i]);
             lwo[j] = static_cast<Real>(l);
@@ -122,7 +121,7 @@ struct ParticleTeamPairStep {
           add_shifted_particle<float_exp>(l - shift_s[s], convert<double>(x[k]) - ref, w[s]);
         }
       }
-    }
+    });
     w[0].max_log_weight = top[0];
     w[1].max_log_weight = top[1];
   }

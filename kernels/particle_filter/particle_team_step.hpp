@@ -74,10 +74,8 @@ struct ParticleTeamStep {
     const Mat<p, p, S>& precision = d.observation_precision.template as<S>();
     const Vec<p, S> vinv_dy_s = convert<S>(vinv_dy);
     const S shift_s = static_cast<S>(shift);  // team_shift<S>: exact
-    for (int base = c.begin / 2 + c.rank; base < (c.end + 1) / 2; base += device_pairs_per_batch * c.threads) {
-      Vec<n, S> x[B];  // fp32's float steps hold their particles in float
-      S lw[B];
-      load_particle_batch<n, Initialize>(xm, lwm, stride, base, c.threads, c.end, x, lw);
+    // fp32's float steps hold their particles in float
+    for_each_particle_batch<n, Initialize, S>(c, xm, lwm, stride, [&](int base, Vec<n, S>* x, S* lw) {
       Vec<K> z[B];
       double u[B];
       draw_particle_batch<Model, Initialize, fp32_step_draws<Real, Initialize>>(key, member, base, c.threads, step,
@@ -85,16 +83,19 @@ struct ParticleTeamStep {
       KUSHNER_DEVICE_UNROLL
       for (int k = 0; k < B; ++k) {
         const int j = batch_particle(base, k, c.threads);
-        if (j >= c.end) continue;
-        const S l = update_particle<Initialize, Mixed>(d, d.t, precision, z[k], u[k], lw[k], log_normalizer, vinv_dy_s,
-                                                       control, x[k]);
-        KUSHNER_DEVICE_UNROLL
-        for (int i = 0; i < n; ++i) xm[j + i * stride] = static_cast<Real>(x[k][i]);
-        lwm[j] = static_cast<Real>(l);
+        const bool live = j < c.end;  // else stepped from zeros and dropped (for_each_particle_batch)
+        S l = update_particle<Initialize, Mixed>(d, d.t, precision, z[k], u[k], lw[k], log_normalizer, vinv_dy_s,
+                                                 control, x[k]);
+        if (!live) l = static_cast<S>(-math::infinity());
+        if (live) {
+          KUSHNER_DEVICE_UNROLL
+          for (int i = 0; i < n; ++i) xm[j + i * stride] = static_cast<Real>(x[k][i]);
+          lwm[j] = static_cast<Real>(l);
+        }
         top = l > top ? l : top;
         add_shifted_particle<float_exp>(l - shift_s, convert<double>(x[k]) - ref, w);
       }
-    }
+    });
     w.max_log_weight = top;
   }
 };
