@@ -11,6 +11,7 @@
 
 #include <Kokkos_Core.hpp>
 
+#include <cstdint>
 #include <type_traits>
 
 namespace kushner {
@@ -43,12 +44,58 @@ KOKKOS_INLINE_FUNCTION int batch_particle(int base, int k, int threads) {
   return 2 * (base + (k / 2) * threads) + k % 2;
 }
 
+/// Whether a kernel moves each pair of particles 2p, 2p + 1 of a member as one 8-byte access (load_particle_batch,
+/// store_particle_batch): fp32 on a GPU, where the member's columns hold an even number of particles and start at
+/// 8-byte boundaries (p0 .. p3: the columns a kernel reads and writes). A warp's access then takes each 32-byte sector
+/// once, where the accesses of its even and of its odd particles took each sector twice: the L2 had become the limit
+/// of fp32's fused pass (95% of its throughput), at 68% of the DRAM's.
+template <class Real>
+KOKKOS_INLINE_FUNCTION bool moves_whole_pairs(int num_particles, std::size_t stride, const Real* p0, const Real* p1,
+                                              const Real* p2, const Real* p3) {
+#if KUSHNER_CUDA_DEVICE_PASS
+  const auto address = [](const Real* p) { return reinterpret_cast<std::uintptr_t>(p); };
+  return std::is_same_v<Real, float> && num_particles % 2 == 0 && stride % 2 == 0 &&
+         ((address(p0) | address(p1) | address(p2) | address(p3)) & 7) == 0;
+#else
+  (void)num_particles, (void)stride, (void)p0, (void)p1, (void)p2, (void)p3;
+  return false;
+#endif
+}
+
 /// Loads the batch's particles (and log-weights, unless initializing) from one member's columns: xm[j + i * stride]
 /// and lwm[j], as H: the scalar a step computes in (float for fp32's float steps, which hold their particles in float
-/// from load to store; else double). Slots past `end` get zeros (for_each_particle_batch).
+/// from load to store; else double); each pair in one access where `paired` (moves_whole_pairs). Slots past `end` get
+/// zeros (for_each_particle_batch).
 template <int N, bool Initialize, class Real, class H>
 KOKKOS_INLINE_FUNCTION void load_particle_batch(const Real* xm, const Real* lwm, std::size_t stride, int base,
-                                                int threads, int end, Vec<N, H>* x, H* lw) {
+                                                int threads, int end, bool paired, Vec<N, H>* x, H* lw) {
+#if KUSHNER_CUDA_DEVICE_PASS
+  if constexpr (std::is_same_v<Real, float>) {
+    if (paired) {
+      KUSHNER_DEVICE_UNROLL
+      for (int b = 0; b < device_pairs_per_batch; ++b) {
+        const int j = batch_particle(base, 2 * b, threads);
+        x[2 * b] = x[2 * b + 1] = Vec<N, H>::zero();
+        lw[2 * b] = lw[2 * b + 1] = H(0);
+        if (j < end) {
+          KUSHNER_DEVICE_UNROLL
+          for (int i = 0; i < N; ++i) {
+            const float2 v = *reinterpret_cast<const float2*>(xm + j + i * stride);
+            x[2 * b][i] = v.x;
+            x[2 * b + 1][i] = v.y;
+          }
+          if (!Initialize) {
+            const float2 v = *reinterpret_cast<const float2*>(lwm + j);
+            lw[2 * b] = v.x;
+            lw[2 * b + 1] = v.y;
+          }
+        }
+      }
+      return;
+    }
+  }
+#endif
+  (void)paired;
   KUSHNER_DEVICE_UNROLL
   for (int k = 0; k < 2 * device_pairs_per_batch; ++k) {
     const int j = batch_particle(base, k, threads);
@@ -63,6 +110,39 @@ KOKKOS_INLINE_FUNCTION void load_particle_batch(const Real* xm, const Real* lwm,
   }
 }
 
+/// Stores the batch's stepped particles x and log-weights l into one member's columns, as load_particle_batch loaded
+/// them: the slots below `end` only.
+template <int N, class Real, class H>
+KOKKOS_INLINE_FUNCTION void store_particle_batch(Real* xm, Real* lwm, std::size_t stride, int base, int threads,
+                                                 int end, bool paired, const Vec<N, H>* x, const H* l) {
+#if KUSHNER_CUDA_DEVICE_PASS
+  if constexpr (std::is_same_v<Real, float>) {
+    if (paired) {
+      KUSHNER_DEVICE_UNROLL
+      for (int b = 0; b < device_pairs_per_batch; ++b) {
+        const int j = batch_particle(base, 2 * b, threads);
+        if (j >= end) continue;
+        KUSHNER_DEVICE_UNROLL
+        for (int i = 0; i < N; ++i)
+          *reinterpret_cast<float2*>(xm + j + i * stride) =
+              float2{static_cast<float>(x[2 * b][i]), static_cast<float>(x[2 * b + 1][i])};
+        *reinterpret_cast<float2*>(lwm + j) = float2{static_cast<float>(l[2 * b]), static_cast<float>(l[2 * b + 1])};
+      }
+      return;
+    }
+  }
+#endif
+  (void)paired;
+  KUSHNER_DEVICE_UNROLL
+  for (int k = 0; k < 2 * device_pairs_per_batch; ++k) {
+    const int j = batch_particle(base, k, threads);
+    if (j >= end) continue;
+    KUSHNER_DEVICE_UNROLL
+    for (int i = 0; i < N; ++i) xm[j + i * stride] = static_cast<Real>(x[k][i]);
+    lwm[j] = static_cast<Real>(l[k]);
+  }
+}
+
 /// body(base, x, lw) for each batch of the thread's pairs of the chunk, its particles and log-weights loaded into x
 /// and lw (load_particle_batch). A batch's slots past the chunk's end hold zeros: the kernels step them too and keep
 /// neither their values nor their weights (without a branch around each particle's step: fp32's fused pass x1.065,
@@ -72,14 +152,14 @@ KOKKOS_INLINE_FUNCTION void load_particle_batch(const Real* xm, const Real* lwm,
 /// the loads ahead take 8 more registers of the launch bound's 64 (fp64 x0.986, mixed x0.933).
 template <int N, bool Initialize, class H, class Real, class Body>
 KOKKOS_INLINE_FUNCTION void for_each_particle_batch(const ParticleChunk& c, const Real* xm, const Real* lwm,
-                                                    std::size_t stride, const Body& body) {
+                                                    std::size_t stride, bool paired, const Body& body) {
   constexpr int B = 2 * device_pairs_per_batch;
   constexpr bool load_ahead = std::is_same_v<H, float> && !Initialize;
   const int first = c.begin / 2 + c.rank, last = (c.end + 1) / 2, step = device_pairs_per_batch * c.threads;
   Vec<N, H> x[B], ahead_x[B];
   H lw[B], ahead_lw[B];
   if (load_ahead && first < last)
-    load_particle_batch<N, Initialize>(xm, lwm, stride, first, c.threads, c.end, ahead_x, ahead_lw);
+    load_particle_batch<N, Initialize>(xm, lwm, stride, first, c.threads, c.end, paired, ahead_x, ahead_lw);
   for (int base = first; base < last; base += step) {
     if constexpr (load_ahead) {
       KUSHNER_DEVICE_UNROLL
@@ -88,9 +168,9 @@ KOKKOS_INLINE_FUNCTION void for_each_particle_batch(const ParticleChunk& c, cons
         lw[k] = ahead_lw[k];
       }
       if (base + step < last)
-        load_particle_batch<N, Initialize>(xm, lwm, stride, base + step, c.threads, c.end, ahead_x, ahead_lw);
+        load_particle_batch<N, Initialize>(xm, lwm, stride, base + step, c.threads, c.end, paired, ahead_x, ahead_lw);
     } else {
-      load_particle_batch<N, Initialize>(xm, lwm, stride, base, c.threads, c.end, x, lw);
+      load_particle_batch<N, Initialize>(xm, lwm, stride, base, c.threads, c.end, paired, x, lw);
     }
     body(base, x, lw);
   }

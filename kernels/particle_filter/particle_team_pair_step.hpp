@@ -94,7 +94,8 @@ struct ParticleTeamPairStep {
     const Vec<p, S> vinv_dy_s[2] = {convert<S>(vinv_dy[0]), convert<S>(vinv_dy[1])};
     const S shift_s[2] = {static_cast<S>(shift[0]), static_cast<S>(shift[1])};  // team_shift<S>: exact
     // fp32's float steps hold their particles in float
-    for_each_particle_batch<n, false, S>(c, xm, lwm, stride, [&](int base, Vec<n, S>* x, S* lw) {
+    const bool paired = moves_whole_pairs(d.num_particles, stride, xm, lwm, xo, lwo);
+    for_each_particle_batch<n, false, S>(c, xm, lwm, stride, paired, [&](int base, Vec<n, S>* x, S* lw) {
       Vec<K> z[2][B];  // fp32 draws both steps' at once (one block for both where d.step is even), others a step's
       double u[2][B];
       KUSHNER_DEVICE_UNROLL
@@ -111,15 +112,11 @@ struct ParticleTeamPairStep {
           S l = update_particle<false, Mixed>(d, step_time(s), precision<S>(s), z[s][k], u[s][k], lw[k],
                                               s == 0 ? log_normalizer : 0.0, vinv_dy_s[s], uncontrolled(), x[k]);
           if (!live) l = static_cast<S>(-math::infinity());
-          if (s == 1 && live) {
-            KUSHNER_DEVICE_UNROLL
-            for (int i = 0; i < n; ++i) xo[j + i * stride] = static_cast<Real>(x[k][i]);
-            lwo[j] = static_cast<Real>(l);
-          }
           lw[k] = l;
           top[s] = l > top[s] ? l : top[s];
           add_shifted_particle<float_exp>(l - shift_s[s], convert<double>(x[k]) - ref, w[s]);
         }
+        if (s == 1) store_particle_batch<n>(xo, lwo, stride, base, c.threads, c.end, paired, x, lw);
       }
     });
     w[0].max_log_weight = top[0];

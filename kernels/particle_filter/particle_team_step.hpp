@@ -75,7 +75,8 @@ struct ParticleTeamStep {
     const Vec<p, S> vinv_dy_s = convert<S>(vinv_dy);
     const S shift_s = static_cast<S>(shift);  // team_shift<S>: exact
     // fp32's float steps hold their particles in float
-    for_each_particle_batch<n, Initialize, S>(c, xm, lwm, stride, [&](int base, Vec<n, S>* x, S* lw) {
+    const bool paired = moves_whole_pairs(d.num_particles, stride, xm, lwm, xm, lwm);
+    for_each_particle_batch<n, Initialize, S>(c, xm, lwm, stride, paired, [&](int base, Vec<n, S>* x, S* lw) {
       Vec<K> z[B];
       double u[B];
       draw_particle_batch<Model, Initialize, fp32_step_draws<Real, Initialize>>(key, member, base, c.threads, step,
@@ -87,14 +88,11 @@ struct ParticleTeamStep {
         S l = update_particle<Initialize, Mixed>(d, d.t, precision, z[k], u[k], lw[k], log_normalizer, vinv_dy_s,
                                                  control, x[k]);
         if (!live) l = static_cast<S>(-math::infinity());
-        if (live) {
-          KUSHNER_DEVICE_UNROLL
-          for (int i = 0; i < n; ++i) xm[j + i * stride] = static_cast<Real>(x[k][i]);
-          lwm[j] = static_cast<Real>(l);
-        }
+        lw[k] = l;
         top = l > top ? l : top;
         add_shifted_particle<float_exp>(l - shift_s, convert<double>(x[k]) - ref, w);
       }
+      store_particle_batch<n>(xm, lwm, stride, base, c.threads, c.end, paired, x, lw);
     });
     w.max_log_weight = top;
   }
