@@ -712,24 +712,26 @@ TEST(ParticleFilterBank, MixedAndFp32DeviceMatchesHostToFloatRounding) {
   // cumulative weight: host and device in lockstep on an H200 (fp32, seed 20261122's member 1) agreed to 2e-8 for 16
   // steps, then moved 2.6 / N at the first resampling and 18 / N by step 39 after two more, 0.28 of the member's Monte
   // Carlo standard error sd / sqrt(N). So at least 9 of the 12 members agree to 1e-5, and every member within what two
-  // runs with independent particles would meet, 3 sqrt(2) sd / sqrt(N).
-  for (auto precision : {ParticlePrecision::mixed, ParticlePrecision::fp32}) {
-    ParticleFilterOptions options;
-    options.precision = precision;
-    const int particles = 5000;
-    std::vector<double> variance;
-    const auto mh = run_sine<Kokkos::DefaultHostExecutionSpace>(12, particles, 40, options, &variance);
-    for (bool pairs : {false, true}) {
-      const auto md = run_sine<Kokkos::Cuda>(12, particles, 40, options, nullptr, nullptr, pairs);
-      int close = 0;
-      for (int m = 0; m < 12; ++m) {
-        const double independent_runs = 3.0 * std::sqrt(2.0 * variance[m] / particles);
-        EXPECT_NEAR(md[m], mh[m], independent_runs) << to_string(precision) << " " << pairs << " member " << m;
-        close += std::abs(md[m] - mh[m]) < 1e-5 * (1 + std::abs(mh[m]));
+  // runs with independent particles would meet, 3 sqrt(2) sd / sqrt(N). An odd N: the GPU's kernels step a batch slot
+  // past a chunk's end (and drop it), and fp32's move a member's particles one at a time, not in pairs.
+  for (auto precision : {ParticlePrecision::mixed, ParticlePrecision::fp32})
+    for (const int particles : {5000, 4999}) {
+      ParticleFilterOptions options;
+      options.precision = precision;
+      std::vector<double> variance;
+      const auto mh = run_sine<Kokkos::DefaultHostExecutionSpace>(12, particles, 40, options, &variance);
+      for (bool pairs : {false, true}) {
+        const auto md = run_sine<Kokkos::Cuda>(12, particles, 40, options, nullptr, nullptr, pairs);
+        int close = 0;
+        for (int m = 0; m < 12; ++m) {
+          const double independent_runs = 3.0 * std::sqrt(2.0 * variance[m] / particles);
+          EXPECT_NEAR(md[m], mh[m], independent_runs)
+              << to_string(precision) << " N " << particles << " " << pairs << " member " << m;
+          close += std::abs(md[m] - mh[m]) < 1e-5 * (1 + std::abs(mh[m]));
+        }
+        EXPECT_GE(close, 9) << to_string(precision) << " N " << particles << " " << pairs;
       }
-      EXPECT_GE(close, 9) << to_string(precision) << " " << pairs;
     }
-  }
 }
 #endif
 
