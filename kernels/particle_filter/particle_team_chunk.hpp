@@ -1,10 +1,11 @@
 #pragma once
-// What the GPU's team kernels (particle_team_step.hpp: one step; particle_team_pair_step.hpp: two steps fused)
-// share: a team takes one chunk of one member's particles; each thread takes pairs of particles (which share
-// their Philox blocks) in batches, loading a whole batch before it computes; the team's moments are summed as
-// e = exp(l - s) with one shift s per member and step (no running maximum: one exp per particle, and the
-// threads' sums add without rescaling), checked afterwards against the team's largest l. Which members and
-// chunks the league covers is the launcher's choice: every (member, chunk), or the listed members only.
+// What the GPU's team kernels (particle_team_step.hpp: one step; particle_team_pair_step.hpp: two steps fused) share: a
+// team takes one chunk of one member's particles; each thread takes pairs of particles (which share their Philox
+// blocks) in batches, loading a whole batch before it computes (fp32: while it computes the batch before,
+// for_each_particle_batch); the team's moments are summed as e = exp(l - s) with one shift s per member and step (no
+// running maximum: one exp per particle, and the threads' sums add without rescaling), checked afterwards against the
+// team's largest l. Which members and chunks the league covers is the launcher's choice: every (member, chunk), or the
+// listed members only.
 #include "kernels/particle_filter/particle_update.hpp"
 #include "kernels/particle_filter/team_reduction.hpp"
 #include "kernels/particle_filter/tuning.hpp"
@@ -46,9 +47,10 @@ KOKKOS_INLINE_FUNCTION int batch_particle(int base, int k, int threads) {
 
 /// Whether a kernel moves each pair of particles 2p, 2p + 1 of a member as one 8-byte access (load_particle_batch,
 /// store_particle_batch): fp32 on a GPU, where the member's columns hold an even number of particles and start at
-/// 8-byte boundaries (p0 .. p3: the columns a kernel reads and writes). A warp's access then takes each 32-byte sector
-/// once, where the accesses of its even and of its odd particles took each sector twice: the L2 had become the limit
-/// of fp32's fused pass (95% of its throughput), at 68% of the DRAM's.
+/// 8-byte boundaries (p0 .. p3: the columns a kernel reads and writes). Chunks start at even particles (whole pairs),
+/// so a pair's second particle then exists wherever its first does. A warp's access takes each 32-byte sector once,
+/// where the accesses of its even and of its odd particles took each sector twice: the L2 had become the limit of
+/// fp32's fused pass (95% of its throughput), at 68% of the DRAM's.
 template <class Real>
 KOKKOS_INLINE_FUNCTION bool moves_whole_pairs(int num_particles, std::size_t stride, const Real* p0, const Real* p1,
                                               const Real* p2, const Real* p3) {

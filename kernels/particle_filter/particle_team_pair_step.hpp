@@ -93,9 +93,9 @@ struct ParticleTeamPairStep {
     const RngKey key = particle_draw_key<false>(d);
     const Vec<p, S> vinv_dy_s[2] = {convert<S>(vinv_dy[0]), convert<S>(vinv_dy[1])};
     const S shift_s[2] = {static_cast<S>(shift[0]), static_cast<S>(shift[1])};  // team_shift<S>: exact
-    // fp32's float steps hold their particles in float
     const bool paired = moves_whole_pairs(d.num_particles, stride, xm, lwm, xo, lwo);
     for_each_particle_batch<n, false, S>(c, xm, lwm, stride, paired, [&](int base, Vec<n, S>* x, S* lw) {
+      // x and lw in S: fp32's float steps hold their particles in float
       Vec<K> z[2][B];  // fp32 draws both steps' at once (one block for both where d.step is even), others a step's
       double u[2][B];
       KUSHNER_DEVICE_UNROLL

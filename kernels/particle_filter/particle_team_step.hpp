@@ -74,9 +74,9 @@ struct ParticleTeamStep {
     const Mat<p, p, S>& precision = d.observation_precision.template as<S>();
     const Vec<p, S> vinv_dy_s = convert<S>(vinv_dy);
     const S shift_s = static_cast<S>(shift);  // team_shift<S>: exact
-    // fp32's float steps hold their particles in float
     const bool paired = moves_whole_pairs(d.num_particles, stride, xm, lwm, xm, lwm);
     for_each_particle_batch<n, Initialize, S>(c, xm, lwm, stride, paired, [&](int base, Vec<n, S>* x, S* lw) {
+      // x and lw in S: fp32's float steps hold their particles in float
       Vec<K> z[B];
       double u[B];
       draw_particle_batch<Model, Initialize, fp32_step_draws<Real, Initialize>>(key, member, base, c.threads, step,
