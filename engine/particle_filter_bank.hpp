@@ -26,7 +26,6 @@
 #include "kernels/bank.hpp"
 #include "kernels/for_each_member.hpp"
 #include "kernels/particle_filter/chunked_systematic_resample.hpp"
-#include "kernels/particle_filter/copy_listed_members.hpp"
 #include "kernels/particle_filter/particle_block_step.hpp"
 #include "kernels/particle_filter/particle_posterior.hpp"
 #include "kernels/particle_filter/particle_resample_step.hpp"
@@ -243,7 +242,7 @@ class ParticleFilterBank {
     run_posterior(partials_, current_posterior(), log_normalizer_, true);
     if (d.initialize) return;
     if (use_chunked_resample_) {
-      resample_listed(log_normalizer_, d.step);
+      resample_listed(resample_data(log_normalizer_, d.step));
       return;
     }
     if constexpr (!std::is_same<MemSpace, Kokkos::HostSpace>::value) {
@@ -279,19 +278,23 @@ class ParticleFilterBank {
 
   PosteriorViews current_posterior() const { return {mean_, covariance_, ess_, status_}; }
 
-  /// Chunked systematic resampling of the listed members at `step`, from the log-weights less `log_normalizer`.
-  void resample_listed(const BankScalar<double, MemSpace>& log_normalizer, std::uint32_t step) {
-    const ChunkedResampleData<MemSpace, Real> r{x_,
-                                                x_scratch_,
-                                                workspace_.cumulative,
-                                                workspace_.ancestors,
-                                                block_sums_,
-                                                log_normalizer,
-                                                resample_list_,
-                                                resample_list_size_,
-                                                num_particles_,
-                                                seed_,
-                                                step};
+  /// Chunked systematic resampling, in place, of the listed members at `step`, from the log-weights less
+  /// `log_normalizer`.
+  ChunkedResampleData<MemSpace, Real> resample_data(const BankScalar<double, MemSpace>& log_normalizer,
+                                                    std::uint32_t step) const {
+    return {x_,
+            x_scratch_,
+            workspace_.cumulative,
+            workspace_.ancestors,
+            block_sums_,
+            log_normalizer,
+            resample_list_,
+            resample_list_size_,
+            num_particles_,
+            seed_,
+            step};
+  }
+  void resample_listed(const ChunkedResampleData<MemSpace, Real>& r) {
     // A fixed league loops over (member, chunk) items: the number of members to resample stays on the device.
     const long items = static_cast<long>(num_members_) * resample_chunks(num_particles_);
     const int league = static_cast<int>(items < chunked_resample_league ? items : chunked_resample_league);
@@ -499,7 +502,7 @@ void ParticleFilterBank<ExecSpace, Model, Real>::step_pair(long k, double dt, co
     run_team_kernel(
         ParticleTeamPairStep<Model, ExecSpace, Real, decltype(mixed)::value>{step_data(k * dt, dt, first, dy), next});
   });
-  // The pass's output becomes the bank; its input (step k - 1's particles) stays for the redo.
+  // The pass's output becomes the bank; its input (step k - 1's particles) stays in the second bank for the redo.
   std::swap(x_, x_next_);
   std::swap(workspace_.cumulative, log_weight_next_);
   // Step k's posterior. The reference point and log-normalizer stay step k - 1's: both steps of the pass
@@ -507,19 +510,22 @@ void ParticleFilterBank<ExecSpace, Model, Real>::step_pair(long k, double dt, co
   Kokkos::deep_copy(space_, resample_list_size_, 0);
   run_posterior(partials_, first_, first_log_normalizer_, false);
   Kokkos::deep_copy(space_, first_.status, status_);
-  // The members step k resamples: copy their step k - 1 particles back, step k, resample, step k + 1.
-  const long copy_items = static_cast<long>(num_members_) * num_particles_;
-  copy_listed_members<state_dim>(
-      space_, CopyListedMembers<state_dim, MemSpace, Real>{
-                  x_next_, x_, log_weight_next_, workspace_.cumulative, resample_list_, resample_list_size_,
-                  num_particles_, copy_items < listed_copy_items ? copy_items : listed_copy_items});
+  // The members step k resamples: step k again, in the second bank (from step k - 1's particles, no copy of them);
+  // resampled from there into the bank (log-weights 0, log-normalizer log N: no copy back); step k + 1 again.
+  ParticleStepData<Model, MemSpace, Real> again = step_data(k * dt, dt, first, dy);
+  again.x = x_next_;
+  again.log_weight = log_weight_next_;
   with_team_arithmetic([&](auto mixed) {
-    run_team_kernel_listed(
-        ParticleTeamStep<Model, ExecSpace, Real, decltype(mixed)::value>{step_data(k * dt, dt, first, dy)});
+    run_team_kernel_listed(ParticleTeamStep<Model, ExecSpace, Real, decltype(mixed)::value>{again});
   });
-  resample_listed(first_log_normalizer_, first);
+  ChunkedResampleData<MemSpace, Real> into_bank = resample_data(first_log_normalizer_, first);
+  into_bank.x = x_next_;
+  into_bank.log_weight = log_weight_next_;
+  into_bank.x_into = x_;
+  into_bank.log_weight_into = workspace_.cumulative;
+  into_bank.log_normalizer_into = log_normalizer_;
+  resample_listed(into_bank);
   ParticleStepData<Model, MemSpace, Real> redo = step_data((k + 1) * dt, dt, second, dy_next);
-  redo.log_normalizer = first_log_normalizer_;  // log N after the resampling
   redo.partials = partials_next_;
   with_team_arithmetic([&](auto mixed) {
     run_team_kernel_listed(ParticleTeamStep<Model, ExecSpace, Real, decltype(mixed)::value>{redo});
@@ -527,7 +533,7 @@ void ParticleFilterBank<ExecSpace, Model, Real>::step_pair(long k, double dt, co
   // Step k + 1's posterior and resampling, as in step().
   Kokkos::deep_copy(space_, resample_list_size_, 0);
   run_posterior(partials_next_, current_posterior(), log_normalizer_, true);
-  resample_listed(log_normalizer_, second);
+  resample_listed(resample_data(log_normalizer_, second));
 }
 
 template <class ExecSpace, class Model, class Real>

@@ -186,9 +186,10 @@ TYPED_TEST_SUITE(ChunkedSystematic, test::ExecutionSpaces);
 
 /// Resamples the `listed` members of a bank of n particles by the chunked path and by the one-team path on
 /// the same backend: the same ancestors, the particles moved accordingly, and only the listed members changed.
-/// Log-weights with rounding everywhere and dead particles; stored as Real (float: the fp32 precision).
+/// Log-weights with rounding everywhere and dead particles; stored as Real (float: the fp32 precision). `into`: the
+/// chunked path writes into another bank (ChunkedResampleData::x_into), and leaves its input as it was.
 template <class Space, class Real = double>
-void check_chunked_against_team_path(int n, int members, const std::vector<int>& listed) {
+void check_chunked_against_team_path(int n, int members, const std::vector<int>& listed, bool into = false) {
   using Mem = typename Space::memory_space;
   const std::uint32_t step = 17;
   ChunkedResampleData<Mem, Real> d;
@@ -222,6 +223,15 @@ void check_chunked_against_team_path(int n, int members, const std::vector<int>&
   for (std::size_t k = 0; k < listed.size(); ++k) list(k) = listed[k];
   Kokkos::deep_copy(d.members, list);
   Kokkos::deep_copy(d.member_count, static_cast<int>(listed.size()));
+  const double untouched = -7.0;  // what the other bank holds where nothing is resampled into it
+  if (into) {
+    d.x_into = ParticleBank<Mem, Real>("x_into", n, members, 2);
+    d.log_weight_into = decltype(d.log_weight_into)("l_into", n, members);
+    d.log_normalizer_into = BankScalar<double, Mem>("log_normalizer_into", members);
+    Kokkos::deep_copy(d.x_into, untouched);
+    Kokkos::deep_copy(d.log_weight_into, untouched);
+    Kokkos::deep_copy(d.log_normalizer_into, untouched);
+  }
 
   // The one-team path on the same backend: weights exp(l - log_normalizer), then resample_members.
   ResamplingWorkspace<Mem, Real> ws;
@@ -236,12 +246,21 @@ void check_chunked_against_team_path(int n, int members, const std::vector<int>&
   Space().fence();
   const auto expected = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), ws.ancestors);
   const auto ancestors = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), d.ancestors);
-  const auto x_after = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), d.x);
-  const auto l_after = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), d.log_weight);
-  const auto n_after = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), d.log_normalizer);
+  const auto x_after = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), into ? d.x_into : d.x);
+  const auto l_after =
+      Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), into ? d.log_weight_into : d.log_weight);
+  const auto n_after =
+      Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), into ? d.log_normalizer_into : d.log_normalizer);
+  const auto x_input = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), d.x);
+  const auto l_input = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), d.log_weight);
+  const auto n_input = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), d.log_normalizer);
   for (int m = 0; m < members; ++m) {
     const bool resampled = std::find(listed.begin(), listed.end(), m) != listed.end();
-    EXPECT_EQ(n_after(m), resampled ? std::log(double(n)) : log_normalizer(m)) << m;
+    const bool kept = into && !resampled;  // the other bank as it was
+    EXPECT_EQ(n_after(m), resampled ? std::log(double(n)) : (kept ? untouched : log_normalizer(m))) << m;
+    if (into) {
+      EXPECT_EQ(n_input(m), log_normalizer(m)) << m;
+    }
     int mismatches = 0;
     for (int s = 0; s < n; ++s) {
       const int a = resampled ? expected(s, m) : s;
@@ -249,9 +268,13 @@ void check_chunked_against_team_path(int n, int members, const std::vector<int>&
       if (resampled) {
         EXPECT_NE(l(a, m), -std::numeric_limits<double>::infinity()) << "dead particle drawn, member " << m;
       }
-      EXPECT_EQ(x_after(s, m, 0), x(a, m, 0));
-      EXPECT_EQ(x_after(s, m, 1), x(a, m, 1));
-      EXPECT_EQ(l_after(s, m), resampled ? 0.0 : l(s, m));
+      EXPECT_EQ(x_after(s, m, 0), kept ? untouched : x(a, m, 0));
+      EXPECT_EQ(x_after(s, m, 1), kept ? untouched : x(a, m, 1));
+      EXPECT_EQ(l_after(s, m), resampled ? 0.0 : (kept ? untouched : l(s, m)));
+      if (into) {
+        EXPECT_EQ(x_input(s, m, 0), x(s, m, 0));
+        EXPECT_EQ(l_input(s, m), l(s, m));
+      }
     }
     EXPECT_EQ(mismatches, 0) << "member " << m;
   }
@@ -268,6 +291,13 @@ TYPED_TEST(ChunkedSystematic, MatchesTheTeamPathAndMovesTheParticles) {
 TYPED_TEST(ChunkedSystematic, MatchesTheTeamPathInFloatStorage) {
   // The fp32 precision: weights and cumulative weights stored in float, summed in double by both paths.
   check_chunked_against_team_path<TypeParam, float>(5003, 6, {3, 0, 5, 2});
+}
+
+TYPED_TEST(ChunkedSystematic, IntoAnotherBankLeavesTheInput) {
+  // ParticleFilterBank::step_pair resamples the members its first step resamples from the second bank into the
+  // first: no copy back.
+  check_chunked_against_team_path<TypeParam>(5003, 6, {3, 0, 5, 2}, true);
+  check_chunked_against_team_path<TypeParam, float>(5003, 6, {4, 1}, true);
 }
 
 }  // namespace

@@ -2,15 +2,18 @@
 // Systematic resampling of the members that need it, spread over many teams per member: the particle
 // filter's resampling path on GPUs. A member resampled by one team (one multiprocessor) leaves the rest of the
 // GPU idle (perf/particle_filter.md, "Resampling"); here every chunk of particles of every listed member is
-// a work item, in four kernels:
+// a work item, in three kernels:
 //   1. block sums:  w_j = exp(l_j - log_normalizer) summed sequentially over each scan block
-//   2. cumulative:  each block's cumulative weights C_j, from the prefix of the block sums, over the
-//                   log-weights (which resampling resets anyway)
-//   3. scatter:     particle j is copied into the slots s with g(C_{j-1}) <= s < g(C_j),
-//                   g(C) = ceil(N C / C_{N-1} - u)
-//   4. copy back:   the resampled particles return to the bank, with equal weights
+//   2. scatter:     the chunk's cumulative weights C_j in team scratch, each block's from the prefix of the block
+//                   sums; then particle j is copied into the slots s with g(C_{j-1}) <= s < g(C_j),
+//                   g(C) = ceil(N C / C_{N-1} - u). C_{begin-1} and the total C_{N-1} come from two more chains:
+//                   the block before the chunk and the member's last block.
+//   3. copy back:   the resampled particles return to the bank, with equal weights (none where the scatter wrote
+//                   them into another bank: ChunkedResampleData::x_into)
 // Every thread's sequential chain is at most one scan block long (or the block sums before it, read from team
-// scratch), so no thread recomputes whole blocks of exp() alone.
+// scratch), so no thread recomputes whole blocks of exp() alone. The cumulative weights never go to memory: the
+// scatter takes them from the team that computed them (one kernel launch and one pass over the weights fewer than
+// a kernel of their own).
 // The kernels are latency-bound (a step resamples one or two members of a thousand), so each thread issues
 // the loads of its share of a chunk together: one memory latency per chunk, not one per particle.
 // The sums are the ones blocked_inclusive_scan and resample_member compute (same blocks, same sequential
@@ -40,8 +43,8 @@ KOKKOS_INLINE_FUNCTION constexpr int resample_chunks(int n) {
   return (scan_num_blocks(n) + resample_chunk_blocks(n) - 1) / resample_chunk_blocks(n);
 }
 
-/// What the four kernels read and write. Views are (particle, member[, i]) or (member), LayoutLeft; the particles
-/// and log-weights (then cumulative weights) stored as Real.
+/// What the three kernels read and write. Views are (particle, member[, i]) or (member), LayoutLeft; the particles
+/// and log-weights stored as Real.
 template <class MemSpace, class Real = double>
 struct ChunkedResampleData {
   using Stored = Real;
@@ -55,7 +58,15 @@ struct ChunkedResampleData {
   int num_particles = 0;
   Seed seed;
   std::uint32_t step = 0;
+  // Where allocated: the resampled particles go into this other bank, with log-weights 0 and log-normalizer log N,
+  // and x, log_weight and log_normalizer stay as they were (no copy back; x_scratch unused).
+  ParticleBank<MemSpace, Real> x_into;
+  ParticleColumn<MemSpace, Real> log_weight_into;
+  BankScalar<double, MemSpace> log_normalizer_into;
 };
+
+/// The log-normalizer of n particles of log-weight 0, as resampling leaves them.
+KOKKOS_INLINE_FUNCTION double equal_log_normalizer(int n) { return math::log(static_cast<double>(n)); }
 
 namespace detail {
 
@@ -80,54 +91,18 @@ KOKKOS_INLINE_FUNCTION void for_each_batch(const Team& team, int begin, int end,
   for (int j0 = begin + team.team_rank(); j0 < end; j0 += resample_batch * threads) body(j0, threads);
 }
 
-/// The weights exp(l - log_normalizer) of particles [begin, end) into team scratch, loaded by the whole team, as
-/// the one-team path stores them (rounded to the bank's Real).
+/// The weights exp(l - log_normalizer) of particles [begin, end) into team scratch w(at + j - begin), as the
+/// one-team path stores them (rounded to the bank's Real). No barrier.
 template <class Team, class Data, class Scratch>
 KOKKOS_INLINE_FUNCTION void load_weights(const Team& team, const Data& d, int member, int begin, int end,
-                                         const Scratch& w) {
+                                         const Scratch& w, int at) {
   using Real = typename Data::Stored;
   const double log_total = d.log_normalizer(member);
   for_each_batch(team, begin, end, [&](int j0, int stride) {
     double l[resample_batch];
     for (int k = 0; k < resample_batch; ++k) l[k] = j0 + k * stride < end ? d.log_weight(j0 + k * stride, member) : 0.0;
     for (int k = 0; k < resample_batch; ++k)
-      if (j0 + k * stride < end) w(j0 + k * stride - begin) = stored_value<Real>(math::exp(l[k] - log_total));
-  });
-  team.team_barrier();
-}
-
-/// offsets(k) = the sum of block_sums(0 .. first_block + k - 1, member) in index order (blocked_inclusive_scan's
-/// exclusive prefix), k < blocks. The block sums come into team scratch `sums` first, in one parallel load.
-template <class Team, class Data, class Scratch>
-KOKKOS_INLINE_FUNCTION void block_offsets(const Team& team, const Data& d, int member, int first_block, int blocks,
-                                          const Scratch& sums, const Scratch& offsets) {
-  Kokkos::parallel_for(Kokkos::TeamThreadRange(team, first_block + blocks),
-                       [&](const int b) { sums(b) = d.block_sums(b, member); });
-  team.team_barrier();
-  Kokkos::parallel_for(Kokkos::TeamThreadRange(team, blocks), [&](const int k) {
-    double offset = 0.0;
-    for (int b = 0; b < first_block + k; ++b) offset += sums(b);
-    offsets(k) = offset;
-  });
-  team.team_barrier();
-}
-
-/// For each work item: the chunk's weights into team scratch `w`, then, on one thread per scan block of the
-/// chunk, body(member, b, begin, lo, hi, offset): block b, the chunk's first particle, the block's entries
-/// [lo, hi) of w and (WithOffsets) the sum of the member's block sums before b, else 0. `w` has
-/// scan_num_blocks(n) entries at least; `offsets` resample_chunk_blocks(n).
-template <bool WithOffsets, class Team, class Data, class Scratch, class Body>
-KOKKOS_INLINE_FUNCTION void for_each_weight_block(const Team& team, const Data& d, const Scratch& w,
-                                                  const Scratch& offsets, const Body& body) {
-  for_each_chunk(team, d, [&](int member, int begin, int end) {
-    const int block = scan_block_size(d.num_particles);
-    const int first_block = begin / block, blocks = (end - begin + block - 1) / block;
-    if (WithOffsets) block_offsets(team, d, member, first_block, blocks, w, offsets);  // before w holds weights
-    load_weights(team, d, member, begin, end, w);
-    Kokkos::parallel_for(Kokkos::TeamThreadRange(team, blocks), [&](const int k) {
-      const int lo = k * block, hi = lo + block < end - begin ? lo + block : end - begin;
-      body(member, first_block + k, begin, lo, hi, WithOffsets ? offsets(k) : 0.0);
-    });
+      if (j0 + k * stride < end) w(at + j0 + k * stride - begin) = stored_value<Real>(math::exp(l[k] - log_total));
   });
 }
 
@@ -147,80 +122,142 @@ KOKKOS_INLINE_FUNCTION double add_in_order(const Scratch& w, int lo, int hi, dou
   return running;
 }
 
+/// The scan blocks whose cumulative weights the scatter of a chunk needs, a chain each: the chunk's own blocks
+/// (chains 0 .. blocks - 1, each C_j kept), then the block before the chunk (for C_{begin-1}) and the member's last
+/// block (for the total C_{N-1}) where the chunk holds neither (their last C alone kept, in `ends`).
+struct ScatterChains {
+  int block, first_block, blocks, previous, last;  // previous, last: block indices, or -1
+  int count;                                       // chains
+  KOKKOS_INLINE_FUNCTION ScatterChains(int n, int begin, int end) {
+    block = scan_block_size(n);
+    first_block = begin / block;
+    blocks = (end - begin + block - 1) / block;
+    previous = first_block > 0 ? first_block - 1 : -1;
+    last = scan_num_blocks(n) - 1 >= first_block + blocks ? scan_num_blocks(n) - 1 : -1;
+    count = blocks + (previous >= 0) + (last >= 0);
+  }
+  /// Chain k's scan block.
+  KOKKOS_INLINE_FUNCTION int block_of(int k) const {
+    return k < blocks ? first_block + k : (k == blocks && previous >= 0 ? previous : last);
+  }
+  /// Where chain k's weights sit in team scratch: the chunk's at 0, then the previous block's, then the last one's.
+  KOKKOS_INLINE_FUNCTION int scratch_at(int k, int chunk_size) const {
+    return k < blocks ? k * block : chunk_size + (k - blocks) * block;
+  }
+};
+
 }  // namespace detail
 
-/// Kernels 1 and 2, blocked_inclusive_scan's two passes over each chunk. Pass 1 (Cumulative false):
-/// block_sums(b, member) = the sum of scan block b's weights in particle order. Pass 2: the cumulative weights
-/// C_j, from each block's offset, written over the log-weights.
-template <class ExecSpace, bool Cumulative, class Real = double>
-struct ChunkedScanPass {
+/// Kernel 1, blocked_inclusive_scan's first pass over each chunk: block_sums(b, member) = the sum of scan block b's
+/// weights in particle order.
+template <class ExecSpace, class Real = double>
+struct ChunkedBlockSums {
   using MemSpace = typename ExecSpace::memory_space;
   using Team = typename Kokkos::TeamPolicy<ExecSpace>::member_type;
   using Scratch = Kokkos::View<double*, typename ExecSpace::scratch_memory_space, Kokkos::MemoryUnmanaged>;
   ChunkedResampleData<MemSpace, Real> d;
 
-  /// Team scratch: the chunk's weights (or, before them, the member's block sums), then the blocks' offsets.
-  KOKKOS_INLINE_FUNCTION static int weights_size(int n) {
-    return scan_num_blocks(n) > resample_chunk_particles ? scan_num_blocks(n) : resample_chunk_particles;
-  }
-  static std::size_t scratch_bytes(int n) {
-    return Scratch::shmem_size(weights_size(n)) + Scratch::shmem_size(resample_chunk_blocks(n));
-  }
+  static std::size_t scratch_bytes(int) { return Scratch::shmem_size(resample_chunk_particles); }
 
   KOKKOS_INLINE_FUNCTION void operator()(const Team& team) const {
-    const int n = d.num_particles;
-    const Scratch w(team.team_scratch(0), weights_size(n)), offsets(team.team_scratch(0), resample_chunk_blocks(n));
-    detail::for_each_weight_block<Cumulative>(
-        team, d, w, offsets, [&](int member, int b, int begin, int lo, int hi, double offset) {
-          if constexpr (Cumulative)
-            detail::add_in_order(w, lo, hi, offset,
-                                 [&](int j, double c) { d.log_weight(begin + j, member) = static_cast<Real>(c); });
-          else
-            d.block_sums(b, member) = detail::add_in_order(w, lo, hi, 0.0, [](int, double) {});
-        });
-  }
-};
-
-/// Kernel 3: each particle copied into its slots of x_scratch (resample_member's systematic rule, on the
-/// same cumulative weights).
-template <class ExecSpace, int N, class Real = double>
-struct ChunkedSystematicScatter {
-  using MemSpace = typename ExecSpace::memory_space;
-  using Team = typename Kokkos::TeamPolicy<ExecSpace>::member_type;
-  ChunkedResampleData<MemSpace, Real> d;
-
-  KOKKOS_INLINE_FUNCTION void operator()(const Team& team) const {
+    const Scratch w(team.team_scratch(0), resample_chunk_particles);
     detail::for_each_chunk(team, d, [&](int member, int begin, int end) {
-      const int n = d.num_particles;
-      const auto& c = d.log_weight;  // now the cumulative weights
-      const double total = c(n - 1, member);
-      const double u = detail::resampling_uniform(d.seed, member, 0, d.step);
-      detail::for_each_batch(team, begin, end, [&](int j0, int stride) {
-        constexpr int B = resample_batch;
-        double lo[B], hi[B], v[B][N];
-        for (int k = 0; k < B; ++k) {
-          const int j = j0 + k * stride;
-          if (j >= end) continue;
-          lo[k] = j > 0 ? c(j - 1, member) : 0.0;
-          hi[k] = c(j, member);
-          for (int i = 0; i < N; ++i) v[k][i] = d.x(j, member, i);
-        }
-        for (int k = 0; k < B; ++k) {
-          const int j = j0 + k * stride;
-          if (j >= end) continue;
-          const int first = j == 0 ? 0 : detail::ceil_clamped((lo[k] * n) / total - u, n);
-          const int last = j == n - 1 ? n : detail::ceil_clamped((hi[k] * n) / total - u, n);
-          for (int s = first; s < last; ++s) {
-            d.ancestors(s, member) = j;
-            for (int i = 0; i < N; ++i) d.x_scratch(s, member, i) = static_cast<Real>(v[k][i]);
-          }
-        }
+      const int block = scan_block_size(d.num_particles);
+      detail::load_weights(team, d, member, begin, end, w, 0);
+      team.team_barrier();
+      Kokkos::parallel_for(Kokkos::TeamThreadRange(team, (end - begin + block - 1) / block), [&](const int k) {
+        const int lo = k * block, hi = lo + block < end - begin ? lo + block : end - begin;
+        d.block_sums(begin / block + k, member) = detail::add_in_order(w, lo, hi, 0.0, [](int, double) {});
       });
     });
   }
 };
 
-/// Kernel 4: the resampled particles back into the bank, log-weights 0 and log-normalizer log N.
+/// Kernel 2: each chunk's cumulative weights (blocked_inclusive_scan's second pass, rounded to Real as the one-team
+/// path stores them) in team scratch, then each particle copied into its slots of x_scratch, or of x_into
+/// (resample_member's systematic rule).
+template <class ExecSpace, int N, class Real = double>
+struct ChunkedSystematicScatter {
+  using MemSpace = typename ExecSpace::memory_space;
+  using Team = typename Kokkos::TeamPolicy<ExecSpace>::member_type;
+  using Scratch = Kokkos::View<double*, typename ExecSpace::scratch_memory_space, Kokkos::MemoryUnmanaged>;
+  ChunkedResampleData<MemSpace, Real> d;
+
+  /// Team scratch: the chunk's weights and those of the two other chains (before them, the member's block sums, in
+  /// the same place), the chains' offsets, and the two other chains' last cumulative weights.
+  KOKKOS_INLINE_FUNCTION static int chunk_size(int n) { return resample_chunk_blocks(n) * scan_block_size(n); }
+  KOKKOS_INLINE_FUNCTION static int weights_size(int n) {
+    const int weights = chunk_size(n) + 2 * scan_block_size(n);
+    return scan_num_blocks(n) > weights ? scan_num_blocks(n) : weights;
+  }
+  static std::size_t scratch_bytes(int n) {
+    return Scratch::shmem_size(weights_size(n)) + Scratch::shmem_size(resample_chunk_blocks(n) + 2) +
+           Scratch::shmem_size(2);
+  }
+
+  KOKKOS_INLINE_FUNCTION void operator()(const Team& team) const {
+    const int n = d.num_particles, size = chunk_size(n);
+    const Scratch w(team.team_scratch(0), weights_size(n)), offsets(team.team_scratch(0), resample_chunk_blocks(n) + 2),
+        ends(team.team_scratch(0), 2);
+    detail::for_each_chunk(team, d, [&](int member, int begin, int end) {
+      const detail::ScatterChains chains(n, begin, end);
+      // Each chain's offset: the member's block sums before its block, added in index order.
+      Kokkos::parallel_for(Kokkos::TeamThreadRange(team, scan_num_blocks(n)),
+                           [&](const int b) { w(b) = d.block_sums(b, member); });
+      team.team_barrier();
+      Kokkos::parallel_for(Kokkos::TeamThreadRange(team, chains.count), [&](const int k) {
+        double offset = 0.0;
+        for (int b = 0; b < chains.block_of(k); ++b) offset += w(b);
+        offsets(k) = offset;
+      });
+      team.team_barrier();
+      detail::load_weights(team, d, member, begin, end, w, 0);
+      for (int k = chains.blocks; k < chains.count; ++k) {
+        const int lo = chains.block_of(k) * chains.block, hi = lo + chains.block < n ? lo + chains.block : n;
+        detail::load_weights(team, d, member, lo, hi, w, chains.scratch_at(k, size));
+      }
+      team.team_barrier();
+      Kokkos::parallel_for(Kokkos::TeamThreadRange(team, chains.count), [&](const int k) {
+        const int lo = chains.scratch_at(k, size), b = chains.block_of(k);
+        const int hi = lo + ((b + 1) * chains.block < n ? chains.block : n - b * chains.block);
+        if (k < chains.blocks) {
+          detail::add_in_order(w, lo, hi, offsets(k), [&](int j, double c) { w(j) = stored_value<Real>(c); });
+        } else {
+          ends(k - chains.blocks) = stored_value<Real>(detail::add_in_order(w, lo, hi, offsets(k), [](int, double) {}));
+        }
+      });
+      team.team_barrier();
+      const double before = chains.previous >= 0 ? ends(0) : 0.0;  // C_{begin-1}; no particle before the first
+      const double total = chains.last >= 0 ? ends(chains.previous >= 0 ? 1 : 0) : w(n - 1 - begin);
+      const double u = detail::resampling_uniform(d.seed, member, 0, d.step);
+      const bool into = d.x_into.data() != nullptr;
+      const auto& to = into ? d.x_into : d.x_scratch;
+      detail::for_each_batch(team, begin, end, [&](int j0, int stride) {
+        constexpr int B = resample_batch;
+        double v[B][N];
+        for (int k = 0; k < B; ++k)
+          if (j0 + k * stride < end)
+            for (int i = 0; i < N; ++i) v[k][i] = d.x(j0 + k * stride, member, i);
+        for (int k = 0; k < B; ++k) {
+          const int j = j0 + k * stride;
+          if (j >= end) continue;
+          const double lo = j > begin ? w(j - 1 - begin) : before, hi = w(j - begin);
+          const int first = j == 0 ? 0 : detail::ceil_clamped((lo * n) / total - u, n);
+          const int last = j == n - 1 ? n : detail::ceil_clamped((hi * n) / total - u, n);
+          for (int s = first; s < last; ++s) {
+            d.ancestors(s, member) = j;
+            for (int i = 0; i < N; ++i) to(s, member, i) = static_cast<Real>(v[k][i]);
+            if (into) d.log_weight_into(s, member) = 0.0;
+          }
+        }
+      });
+      if (into && begin == 0)
+        Kokkos::single(Kokkos::PerTeam(team), [&]() { d.log_normalizer_into(member) = equal_log_normalizer(n); });
+    });
+  }
+};
+
+/// Kernel 3: the resampled particles back into the bank, log-weights 0 and log-normalizer log N.
 template <class ExecSpace, int N, class Real = double>
 struct ChunkedCopyBack {
   using MemSpace = typename ExecSpace::memory_space;
@@ -242,13 +279,14 @@ struct ChunkedCopyBack {
       });
       if (begin == 0)
         Kokkos::single(Kokkos::PerTeam(team),
-                       [&]() { d.log_normalizer(member) = math::log(static_cast<double>(d.num_particles)); });
+                       [&]() { d.log_normalizer(member) = equal_log_normalizer(d.num_particles); });
     });
   }
 };
 
-/// Resamples the listed members systematically (d.members, d.member_count on the device). `team_size`:
-/// threads per team; `league`: teams, each looping over the work items. No fence.
+/// Resamples the listed members systematically (d.members, d.member_count on the device): in place, or into
+/// d.x_into where allocated. `team_size`: threads per team; `league`: teams, each looping over the work items. No
+/// fence.
 template <int N, class ExecSpace, class Real>
 void chunked_systematic_resample(const ExecSpace& space,
                                  const ChunkedResampleData<typename ExecSpace::memory_space, Real>& d, int team_size,
@@ -256,15 +294,17 @@ void chunked_systematic_resample(const ExecSpace& space,
   KUSHNER_REQUIRE(chunked_resample_supports(d.num_particles),
                   "chunked resampling: " << d.num_particles << " particles per member is more than it supports");
   using Policy = Kokkos::TeamPolicy<ExecSpace>;
-  const std::size_t scratch = ChunkedScanPass<ExecSpace, false, Real>::scratch_bytes(d.num_particles);
+  const int n = d.num_particles;
   Kokkos::parallel_for("kushner::resample_block_sums",
-                       Policy(space, league, team_size).set_scratch_size(0, Kokkos::PerTeam(scratch)),
-                       ChunkedScanPass<ExecSpace, false, Real>{d});
-  Kokkos::parallel_for("kushner::resample_cumulative",
-                       Policy(space, league, team_size).set_scratch_size(0, Kokkos::PerTeam(scratch)),
-                       ChunkedScanPass<ExecSpace, true, Real>{d});
-  Kokkos::parallel_for("kushner::resample_scatter", Policy(space, league, team_size),
-                       ChunkedSystematicScatter<ExecSpace, N, Real>{d});
+                       Policy(space, league, team_size)
+                           .set_scratch_size(0, Kokkos::PerTeam(ChunkedBlockSums<ExecSpace, Real>::scratch_bytes(n))),
+                       ChunkedBlockSums<ExecSpace, Real>{d});
+  Kokkos::parallel_for(
+      "kushner::resample_scatter",
+      Policy(space, league, team_size)
+          .set_scratch_size(0, Kokkos::PerTeam(ChunkedSystematicScatter<ExecSpace, N, Real>::scratch_bytes(n))),
+      ChunkedSystematicScatter<ExecSpace, N, Real>{d});
+  if (d.x_into.data() != nullptr) return;
   Kokkos::parallel_for("kushner::resample_copy_back", Policy(space, league, team_size),
                        ChunkedCopyBack<ExecSpace, N, Real>{d});
 }

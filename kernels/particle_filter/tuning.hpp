@@ -52,7 +52,5 @@ constexpr int resample_batch = 8;
 
 /// Fixed league of the team kernel over the listed members' chunks.
 constexpr int listed_team_league = 1024;
-/// Work items of the copy of the listed members' particles (a range loop over (particle, listed member)).
-constexpr long listed_copy_items = 1L << 18;
 
 }  // namespace kushner
