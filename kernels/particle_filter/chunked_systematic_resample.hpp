@@ -124,11 +124,12 @@ KOKKOS_INLINE_FUNCTION double add_in_order(const Scratch& w, int lo, int hi, dou
 
 /// The scan blocks whose cumulative weights the scatter of a chunk needs, a chain each: the chunk's own blocks
 /// (chains 0 .. blocks - 1, each C_j kept), then the block before the chunk (for C_{begin-1}) and the member's last
-/// block (for the total C_{N-1}) where the chunk holds neither (their last C alone kept, in `ends`).
+/// block (for the total C_{N-1}) where the chunk holds neither (their last C alone kept: ends(0) and ends(1)).
 struct ScatterChains {
-  int block, first_block, blocks, previous, last;  // previous, last: block indices, or -1
-  int count;                                       // chains
-  KOKKOS_INLINE_FUNCTION ScatterChains(int n, int begin, int end) {
+  int n, block, first_block, blocks, previous, last;  // previous, last: block indices, or -1
+  int count;                                          // chains
+  KOKKOS_INLINE_FUNCTION ScatterChains(int num_particles, int begin, int end) {
+    n = num_particles;
     block = scan_block_size(n);
     first_block = begin / block;
     blocks = (end - begin + block - 1) / block;
@@ -139,6 +140,11 @@ struct ScatterChains {
   /// Chain k's scan block.
   KOKKOS_INLINE_FUNCTION int block_of(int k) const {
     return k < blocks ? first_block + k : (k == blocks && previous >= 0 ? previous : last);
+  }
+  /// Chain k's first particle and its number of particles (the member's last block may be short).
+  KOKKOS_INLINE_FUNCTION int first_particle(int k) const { return block_of(k) * block; }
+  KOKKOS_INLINE_FUNCTION int length(int k) const {
+    return first_particle(k) + block < n ? block : n - first_particle(k);
   }
   /// Where chain k's weights sit in team scratch: the chunk's at 0, then the previous block's, then the last one's.
   KOKKOS_INLINE_FUNCTION int scratch_at(int k, int chunk_size) const {
@@ -213,22 +219,22 @@ struct ChunkedSystematicScatter {
       team.team_barrier();
       detail::load_weights(team, d, member, begin, end, w, 0);
       for (int k = chains.blocks; k < chains.count; ++k) {
-        const int lo = chains.block_of(k) * chains.block, hi = lo + chains.block < n ? lo + chains.block : n;
-        detail::load_weights(team, d, member, lo, hi, w, chains.scratch_at(k, size));
+        const int first = chains.first_particle(k);
+        detail::load_weights(team, d, member, first, first + chains.length(k), w, chains.scratch_at(k, size));
       }
       team.team_barrier();
       Kokkos::parallel_for(Kokkos::TeamThreadRange(team, chains.count), [&](const int k) {
-        const int lo = chains.scratch_at(k, size), b = chains.block_of(k);
-        const int hi = lo + ((b + 1) * chains.block < n ? chains.block : n - b * chains.block);
+        const int lo = chains.scratch_at(k, size), hi = lo + chains.length(k);
         if (k < chains.blocks) {
           detail::add_in_order(w, lo, hi, offsets(k), [&](int j, double c) { w(j) = stored_value<Real>(c); });
         } else {
-          ends(k - chains.blocks) = stored_value<Real>(detail::add_in_order(w, lo, hi, offsets(k), [](int, double) {}));
+          const int slot = chains.block_of(k) == chains.previous ? 0 : 1;
+          ends(slot) = stored_value<Real>(detail::add_in_order(w, lo, hi, offsets(k), [](int, double) {}));
         }
       });
       team.team_barrier();
       const double before = chains.previous >= 0 ? ends(0) : 0.0;  // C_{begin-1}; no particle before the first
-      const double total = chains.last >= 0 ? ends(chains.previous >= 0 ? 1 : 0) : w(n - 1 - begin);
+      const double total = chains.last >= 0 ? ends(1) : w(n - 1 - begin);
       const double u = detail::resampling_uniform(d.seed, member, 0, d.step);
       const bool into = d.x_into.data() != nullptr;
       const auto& to = into ? d.x_into : d.x_scratch;
