@@ -79,8 +79,8 @@ class ParticleFilterBank {
 
   /// Bytes the bank allocates for `members` members of `particles` particles: per particle its state and the
   /// resampling scratch copy, its log-weight and ancestor index (and offspring count for residual resampling);
-  /// per member the block partials (at the smallest block, the host's), the scan's block sums and the
-  /// posterior. step_pair's second bank is step_pair_bytes_needed.
+  /// per member the block partials (at the smallest block, the host's), the scan's block sums, the posterior, and
+  /// the chunked resampling's two list entries and count. step_pair's second bank is step_pair_bytes_needed.
   static double bytes_needed(long members, long particles, const ParticleFilterOptions& options) {
     return static_cast<double>(members) *
            (bytes_per_particle(options) * static_cast<double>(particles) + bytes_per_member(particles));
@@ -97,7 +97,7 @@ class ParticleFilterBank {
     const double blocks = static_cast<double>((particles + host_particle_block - 1) / host_particle_block);
     return sizeof(double) * (blocks * WeightedMoments<state_dim>::size + scan_num_blocks(static_cast<int>(particles)) +
                              2.0 + 2.0 * state_dim + packed_size(state_dim)) +
-           3.0 * sizeof(int) + sizeof(Status);
+           5.0 * sizeof(int) + sizeof(Status);
   }
 
   /// Bytes step_pair allocates besides bytes_needed when it fuses its steps: a second bank of states and
@@ -238,7 +238,6 @@ class ParticleFilterBank {
     } else {
       run_host_block_kernel(d);
     }
-    if (use_chunked_resample_) Kokkos::deep_copy(space_, resample_list_size_, 0);
     run_posterior(partials_, current_posterior(), log_normalizer_, true);
     if (d.initialize) return;
     if (use_chunked_resample_) {
@@ -265,15 +264,23 @@ class ParticleFilterBank {
                                                  options_.scheme, seed_, d.step});
   }
 
-  /// The posterior of a step from its block partials, into `out` and `log_normalizer`; resampling decisions
-  /// and counts, and the list of members to resample, into the bank's.
+  /// The posterior of a step from its block partials, into `out` and `log_normalizer` (and the status into
+  /// `status_copy` where allocated); resampling decisions and counts into the bank's, and the members to resample into
+  /// the next of its two lists (whose size it found zero), the other list's size set to zero for the posterior after.
   void run_posterior(const Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace>& partials, const PosteriorViews& out,
-                     const BankScalar<double, MemSpace>& log_normalizer, bool update_reference) {
-    parallel_for_members("kushner::particle_posterior", space_, num_members_,
-                         ParticlePosterior<state_dim, MemSpace>{
-                             partials, num_blocks_, reference_, update_reference, out.mean, out.covariance, out.ess,
-                             log_normalizer, resample_, resample_count_, status_,
-                             options_.ess_threshold * num_particles_, resample_list_, resample_list_size_});
+                     const BankScalar<double, MemSpace>& log_normalizer, bool update_reference,
+                     const BankScalar<Status, MemSpace>& status_copy = {}) {
+    ParticlePosterior<state_dim, MemSpace> posterior{
+        partials, num_blocks_,    reference_, update_reference, out.mean, out.covariance,
+        out.ess,  log_normalizer, resample_,  resample_count_,  status_,  options_.ess_threshold * num_particles_};
+    if (use_chunked_resample_) {
+      list_ = 1 - list_;
+      posterior.resample_list = resample_lists_[list_];
+      posterior.resample_list_size = resample_list_sizes_[list_];
+      posterior.next_list_size = resample_list_sizes_[1 - list_];
+    }
+    posterior.status_copy = status_copy;
+    parallel_for_members("kushner::particle_posterior", space_, num_members_, posterior);
   }
 
   PosteriorViews current_posterior() const { return {mean_, covariance_, ess_, status_}; }
@@ -286,10 +293,11 @@ class ParticleFilterBank {
             x_scratch_,
             workspace_.cumulative,
             workspace_.ancestors,
-            block_sums_,
+            block_offsets_,
+            chunks_done_,
             log_normalizer,
-            resample_list_,
-            resample_list_size_,
+            resample_lists_[list_],
+            resample_list_sizes_[list_],
             num_particles_,
             seed_,
             step};
@@ -331,12 +339,13 @@ class ParticleFilterBank {
                                EveryMemberChunk<Kernel>{kernel, num_blocks_});
   }
 
-  /// ... over the chunks of the members on the resampling list only: a fixed league loops over them.
+  /// ... over the chunks of the members on the last posterior's resampling list only: a fixed league loops over them.
   template <class Kernel>
   void run_team_kernel_listed(const Kernel& kernel) {
     const long items = static_cast<long>(num_blocks_) * num_members_;
-    launch_team_kernel<Kernel>(items < listed_team_league ? items : listed_team_league,
-                               ListedMemberChunks<Kernel>{kernel, resample_list_, resample_list_size_, num_blocks_});
+    launch_team_kernel<Kernel>(
+        items < listed_team_league ? items : listed_team_league,
+        ListedMemberChunks<Kernel>{kernel, resample_lists_[list_], resample_list_sizes_[list_], num_blocks_});
   }
 
   /// Launched with its arguments as kernel parameters (Kokkos' light-weight hint): the functor is over the 512
@@ -382,9 +391,13 @@ class ParticleFilterBank {
   PosteriorViews first_;
   BankScalar<double, MemSpace> first_log_normalizer_;
   bool use_chunked_resample_ = false;
-  Kokkos::View<int*, MemSpace> resample_list_;
-  Kokkos::View<int, MemSpace> resample_list_size_;
-  Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> block_sums_;
+  // The chunked resampling's two lists of members to resample, taken in turn by the posterior kernels (the last one's:
+  // list_), each list's size zeroed by the posterior kernel before the one that appends to it.
+  Kokkos::View<int*, MemSpace> resample_lists_[2];
+  Kokkos::View<int, MemSpace> resample_list_sizes_[2];
+  int list_ = 0;
+  Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> block_offsets_;
+  Kokkos::View<int*, MemSpace> chunks_done_;
   Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace> partials_;
   BankScalar<double, MemSpace> log_normalizer_, ess_;
   BankVector<MemSpace> reference_, mean_;
@@ -431,9 +444,13 @@ ParticleFilterBank<ExecSpace, Model, Real>::ParticleFilterBank(const ExecSpace& 
   workspace_.ancestors = decltype(workspace_.ancestors)("kushner::ancestors", num_particles, num_members);
   use_chunked_resample_ = fuses_step_pairs(options, num_particles);
   if (use_chunked_resample_) {
-    resample_list_ = Kokkos::View<int*, MemSpace>("kushner::resample_list", num_members);
-    resample_list_size_ = Kokkos::View<int, MemSpace>("kushner::resample_list_size");
-    block_sums_ = decltype(block_sums_)("kushner::resample_block_sums", scan_num_blocks(num_particles), num_members);
+    for (int i = 0; i < 2; ++i) {
+      resample_lists_[i] = Kokkos::View<int*, MemSpace>("kushner::resample_list", num_members);
+      resample_list_sizes_[i] = Kokkos::View<int, MemSpace>("kushner::resample_list_size");
+    }
+    block_offsets_ =
+        decltype(block_offsets_)("kushner::resample_block_offsets", scan_num_blocks(num_particles), num_members);
+    chunks_done_ = Kokkos::View<int*, MemSpace>("kushner::resample_chunks_done", num_members);
   }
   if (options.scheme == ResamplingScheme::residual)
     workspace_.copies = decltype(workspace_.copies)("kushner::offspring", num_particles, num_members);
@@ -507,9 +524,7 @@ void ParticleFilterBank<ExecSpace, Model, Real>::step_pair(long k, double dt, co
   std::swap(workspace_.cumulative, log_weight_next_);
   // Step k's posterior. The reference point and log-normalizer stay step k - 1's: both steps of the pass
   // were taken relative to them.
-  Kokkos::deep_copy(space_, resample_list_size_, 0);
-  run_posterior(partials_, first_, first_log_normalizer_, false);
-  Kokkos::deep_copy(space_, first_.status, status_);
+  run_posterior(partials_, first_, first_log_normalizer_, false, first_.status);
   // The members step k resamples: step k again, in the second bank (from step k - 1's particles, no copy of them);
   // resampled from there into the bank (log-weights 0, log-normalizer log N: no copy back); step k + 1 again.
   ParticleStepData<Model, MemSpace, Real> again = step_data(k * dt, dt, first, dy);
@@ -531,7 +546,6 @@ void ParticleFilterBank<ExecSpace, Model, Real>::step_pair(long k, double dt, co
     run_team_kernel_listed(ParticleTeamStep<Model, ExecSpace, Real, decltype(mixed)::value>{redo});
   });
   // Step k + 1's posterior and resampling, as in step().
-  Kokkos::deep_copy(space_, resample_list_size_, 0);
   run_posterior(partials_next_, current_posterior(), log_normalizer_, true);
   resample_listed(resample_data(log_normalizer_, second));
 }

@@ -24,9 +24,20 @@ struct ParticlePosterior {
   BankScalar<Status, MemSpace> status;
   double resample_below;                           // resample when ESS < this (threshold * N)
   Kokkos::View<int*, MemSpace> resample_list;      // if allocated: the resampled members, [0, resample_list_size())
-  Kokkos::View<int, MemSpace> resample_list_size;  // (in any order: each member's resampling is its own)
+  Kokkos::View<int, MemSpace> resample_list_size;  // (in any order: each member's resampling is its own), zero before
+  // If allocated: set to zero by this kernel, the size of the list the next posterior kernel appends to (the bank
+  // alternates two lists, so that no kernel of its own clears them; every reader of that list has run before this).
+  Kokkos::View<int, MemSpace> next_list_size;
+  BankScalar<Status, MemSpace> status_copy;  // if allocated: each member's status after this step, as well
 
   KOKKOS_INLINE_FUNCTION void operator()(const int member) const {
+    if (member == 0 && next_list_size.data() != nullptr) next_list_size() = 0;
+    update(member);
+    if (status_copy.data() != nullptr) status_copy(member) = status(member);
+  }
+
+ private:
+  KOKKOS_INLINE_FUNCTION void update(const int member) const {
     resample(member) = 0;
     if (status(member) != Status::ok) {
       ess(member) = 0.0;
