@@ -80,7 +80,7 @@ class ParticleFilterBank {
   /// Bytes the bank allocates for `members` members of `particles` particles: per particle its state and the
   /// resampling scratch copy, its log-weight and ancestor index (and offspring count for residual resampling);
   /// per member the block partials (at the smallest block, the host's), the scan's block sums, the posterior, and
-  /// the chunked resampling's two list entries and count. step_pair's second bank is step_pair_bytes_needed.
+  /// the chunked resampling's two list entries. step_pair's second bank is step_pair_bytes_needed.
   static double bytes_needed(long members, long particles, const ParticleFilterOptions& options) {
     return static_cast<double>(members) *
            (bytes_per_particle(options) * static_cast<double>(particles) + bytes_per_member(particles));
@@ -97,7 +97,7 @@ class ParticleFilterBank {
     const double blocks = static_cast<double>((particles + host_particle_block - 1) / host_particle_block);
     return sizeof(double) * (blocks * WeightedMoments<state_dim>::size + scan_num_blocks(static_cast<int>(particles)) +
                              2.0 + 2.0 * state_dim + packed_size(state_dim)) +
-           5.0 * sizeof(int) + sizeof(Status);
+           4.0 * sizeof(int) + sizeof(Status);
   }
 
   /// Bytes step_pair allocates besides bytes_needed when it fuses its steps: a second bank of states and
@@ -293,8 +293,7 @@ class ParticleFilterBank {
             x_scratch_,
             workspace_.cumulative,
             workspace_.ancestors,
-            block_offsets_,
-            chunks_done_,
+            block_sums_,
             log_normalizer,
             resample_lists_[list_],
             resample_list_sizes_[list_],
@@ -396,8 +395,7 @@ class ParticleFilterBank {
   Kokkos::View<int*, MemSpace> resample_lists_[2];
   Kokkos::View<int, MemSpace> resample_list_sizes_[2];
   int list_ = 0;
-  Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> block_offsets_;
-  Kokkos::View<int*, MemSpace> chunks_done_;
+  Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> block_sums_;
   Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace> partials_;
   BankScalar<double, MemSpace> log_normalizer_, ess_;
   BankVector<MemSpace> reference_, mean_;
@@ -448,9 +446,7 @@ ParticleFilterBank<ExecSpace, Model, Real>::ParticleFilterBank(const ExecSpace& 
       resample_lists_[i] = Kokkos::View<int*, MemSpace>("kushner::resample_list", num_members);
       resample_list_sizes_[i] = Kokkos::View<int, MemSpace>("kushner::resample_list_size");
     }
-    block_offsets_ =
-        decltype(block_offsets_)("kushner::resample_block_offsets", scan_num_blocks(num_particles), num_members);
-    chunks_done_ = Kokkos::View<int*, MemSpace>("kushner::resample_chunks_done", num_members);
+    block_sums_ = decltype(block_sums_)("kushner::resample_block_sums", scan_num_blocks(num_particles), num_members);
   }
   if (options.scheme == ResamplingScheme::residual)
     workspace_.copies = decltype(workspace_.copies)("kushner::offspring", num_particles, num_members);

@@ -3,22 +3,19 @@
 // filter's resampling path on GPUs. A member resampled by one team (one multiprocessor) leaves the rest of the
 // GPU idle (perf/particle_filter.md, "Resampling"); here every chunk of particles of every listed member is
 // a work item, in three kernels:
-//   1. block offsets: w_j = exp(l_j - log_normalizer) summed sequentially over each scan block; the team that sums a
-//                     member's last chunk (a count per member) turns the member's block sums into each block's offset,
-//                     the sum of the blocks before it
-//   2. scatter:       the chunk's cumulative weights C_j in team scratch, each block's from its offset; then particle
-//                     j is copied into the slots s with g(C_{j-1}) <= s < g(C_j), g(C) = ceil(N C / C_{N-1} - u).
-//                     C_{begin-1} and the total C_{N-1} come from two more chains: the block before the chunk and the
-//                     member's last block.
-//   3. copy back:     the resampled particles return to the bank, with equal weights (none where the scatter wrote
-//                     them into another bank: ChunkedResampleData::x_into)
-// Every thread's sequential chain is at most one scan block long, so no thread recomputes whole blocks of exp() alone,
-// except the one that adds a member's block sums (in kernel 1, once per member: every chunk's scatter added those
-// before its blocks). The cumulative weights never go to memory: the scatter takes them from the team that computed
-// them (one kernel launch and one pass over the weights fewer than a kernel of their own).
+//   1. block sums:  w_j = exp(l_j - log_normalizer) summed sequentially over each scan block
+//   2. scatter:     the chunk's cumulative weights C_j in team scratch, each block's from the prefix of the block
+//                   sums; then particle j is copied into the slots s with g(C_{j-1}) <= s < g(C_j),
+//                   g(C) = ceil(N C / C_{N-1} - u). C_{begin-1} and the total C_{N-1} come from two more chains:
+//                   the block before the chunk and the member's last block.
+//   3. copy back:   the resampled particles return to the bank, with equal weights (none where the scatter wrote
+//                   them into another bank: ChunkedResampleData::x_into)
+// Every thread's sequential chain is at most one scan block long (or the block sums before it, read from team
+// scratch), so no thread recomputes whole blocks of exp() alone. The cumulative weights never go to memory: the
+// scatter takes them from the team that computed them (one kernel launch and one pass over the weights fewer than
+// a kernel of their own).
 // The kernels are latency-bound (a step resamples one or two members of a thousand), so each thread issues
-// the loads of its share of a chunk together: one memory latency per chunk, not one per particle; the scatter loads its
-// chains' offsets and all their weights in one such round.
+// the loads of its share of a chunk together: one memory latency per chunk, not one per particle.
 // The sums are the ones blocked_inclusive_scan and resample_member compute (same blocks, same sequential
 // order, same expressions), so the indices are the same as the one-team path's on every backend; the test
 // ChunkedSystematic.MatchesTheTeamPathAndMovesTheParticles (tests/test_resampling.cpp) checks it.
@@ -53,10 +50,8 @@ struct ChunkedResampleData {
   using Stored = Real;
   ParticleBank<MemSpace, Real> x, x_scratch;
   ParticleColumn<MemSpace, Real> log_weight;
-  Kokkos::View<int**, Kokkos::LayoutLeft, MemSpace> ancestors;  // a_s, kept for inspection and tests
-  // (scan block, member): kernel 1's block sums, then each block's offset (the block sums before it, added in order)
-  Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> block_offsets;
-  Kokkos::View<int*, MemSpace> chunks_done;  // (member): kernel 1's count of the member's chunks summed; zero between
+  Kokkos::View<int**, Kokkos::LayoutLeft, MemSpace> ancestors;      // a_s, kept for inspection and tests
+  Kokkos::View<double**, Kokkos::LayoutLeft, MemSpace> block_sums;  // (scan block, member)
   BankScalar<double, MemSpace> log_normalizer;
   Kokkos::View<int*, MemSpace> members;  // the members to resample: entries [0, member_count())
   Kokkos::View<int, MemSpace> member_count;
@@ -89,11 +84,11 @@ KOKKOS_INLINE_FUNCTION void for_each_chunk(const Team& team, const Data& d, cons
 }
 
 /// body(j0, stride) for each batch of the team's particles [begin, end): the thread's particles
-/// j0 + k stride, k < Batch (those below `end`), whose loads the body issues before it uses them.
-template <int Batch = resample_batch, class Team, class Body>
+/// j0 + k stride, k < resample_batch (those below `end`), whose loads the body issues before it uses them.
+template <class Team, class Body>
 KOKKOS_INLINE_FUNCTION void for_each_batch(const Team& team, int begin, int end, const Body& body) {
   const int threads = team.team_size();
-  for (int j0 = begin + team.team_rank(); j0 < end; j0 += Batch * threads) body(j0, threads);
+  for (int j0 = begin + team.team_rank(); j0 < end; j0 += resample_batch * threads) body(j0, threads);
 }
 
 /// The weights exp(l - log_normalizer) of particles [begin, end) into team scratch w(at + j - begin), as the
@@ -131,12 +126,10 @@ KOKKOS_INLINE_FUNCTION double add_in_order(const Scratch& w, int lo, int hi, dou
 /// (chains 0 .. blocks - 1, each C_j kept), then the block before the chunk (for C_{begin-1}) and the member's last
 /// block (for the total C_{N-1}) where the chunk holds neither (their last C alone kept: ends(0) and ends(1)).
 struct ScatterChains {
-  int n, begin, end, block, first_block, blocks, previous, last;  // previous, last: block indices, or -1
-  int count;                                                      // chains
-  KOKKOS_INLINE_FUNCTION ScatterChains(int num_particles, int chunk_begin, int chunk_end) {
+  int n, block, first_block, blocks, previous, last;  // previous, last: block indices, or -1
+  int count;                                          // chains
+  KOKKOS_INLINE_FUNCTION ScatterChains(int num_particles, int begin, int end) {
     n = num_particles;
-    begin = chunk_begin;
-    end = chunk_end;
     block = scan_block_size(n);
     first_block = begin / block;
     blocks = (end - begin + block - 1) / block;
@@ -157,77 +150,14 @@ struct ScatterChains {
   KOKKOS_INLINE_FUNCTION int scratch_at(int k, int chunk_size) const {
     return k < blocks ? k * block : chunk_size + (k - blocks) * block;
   }
-  /// The chains' weights together: the chunk's particles, then the other chains'.
-  KOKKOS_INLINE_FUNCTION int weights() const {
-    int total = end - begin;
-    for (int k = blocks; k < count; ++k) total += length(k);
-    return total;
-  }
-  /// The v-th of those: its particle, and where its weight sits in team scratch.
-  KOKKOS_INLINE_FUNCTION void weight_place(int v, int chunk_size, int& particle, int& at) const {
-    if (v < end - begin) {
-      particle = begin + v;
-      at = v;
-      return;
-    }
-    v -= end - begin;
-    int k = blocks;
-    if (v >= length(k)) {
-      v -= length(k);
-      ++k;
-    }
-    particle = first_particle(k) + v;
-    at = scratch_at(k, chunk_size) + v;
-  }
 };
-
-/// The weights of all of a chunk's chains (ScatterChains::weights) into team scratch, as load_weights stores them, in
-/// batches of Batch per thread: a 256-thread team loads the 2048 weights of a chunk and the 512 of the two other chains
-/// in one round. No barrier.
-template <int Batch, class Team, class Data, class Scratch>
-KOKKOS_INLINE_FUNCTION void load_chain_weights(const Team& team, const Data& d, int member, const ScatterChains& chains,
-                                               int chunk_size, const Scratch& w) {
-  using Real = typename Data::Stored;
-  const double log_total = d.log_normalizer(member);
-  const int total = chains.weights();
-  for_each_batch<Batch>(team, 0, total, [&](int v0, int stride) {
-    double l[Batch];
-    int at[Batch];
-    for (int k = 0; k < Batch; ++k) {
-      int j = 0;
-      at[k] = -1;
-      if (v0 + k * stride < total) chains.weight_place(v0 + k * stride, chunk_size, j, at[k]);
-      l[k] = at[k] >= 0 ? d.log_weight(j, member) : 0.0;
-    }
-    for (int k = 0; k < Batch; ++k)
-      if (at[k] >= 0) w(at[k]) = stored_value<Real>(math::exp(l[k] - log_total));
-  });
-}
-
-/// v(0 .. count - 1, member) <- its exclusive prefix sums, added in index order (blocked_inclusive_scan's block
-/// offsets). Reads past the GPU's L1 cache: other multiprocessors wrote v within the same kernel.
-template <class View>
-KOKKOS_INLINE_FUNCTION void exclusive_prefix_in_place(const View& v, int member, int count) {
-  double offset = 0.0;
-  for (int b0 = 0; b0 < count; b0 += scan_batch) {
-    double s[scan_batch];
-    for (int i = 0; i < scan_batch; ++i)
-      s[i] = b0 + i < count ? *static_cast<const volatile double*>(&v(b0 + i, member)) : 0.0;
-    for (int i = 0; i < scan_batch; ++i)
-      if (b0 + i < count) {
-        v(b0 + i, member) = offset;
-        offset += s[i];
-      }
-  }
-}
 
 }  // namespace detail
 
-/// Kernel 1, blocked_inclusive_scan's first pass over each chunk, block_offsets(b, member) = the sum of scan block b's
-/// weights in particle order, and its offsets: the team that sums a member's last chunk (chunks_done) adds the member's
-/// block sums in order, each block's offset in its place.
+/// Kernel 1, blocked_inclusive_scan's first pass over each chunk: block_sums(b, member) = the sum of scan block b's
+/// weights in particle order.
 template <class ExecSpace, class Real = double>
-struct ChunkedBlockOffsets {
+struct ChunkedBlockSums {
   using MemSpace = typename ExecSpace::memory_space;
   using Team = typename Kokkos::TeamPolicy<ExecSpace>::member_type;
   using Scratch = Kokkos::View<double*, typename ExecSpace::scratch_memory_space, Kokkos::MemoryUnmanaged>;
@@ -237,26 +167,14 @@ struct ChunkedBlockOffsets {
 
   KOKKOS_INLINE_FUNCTION void operator()(const Team& team) const {
     const Scratch w(team.team_scratch(0), resample_chunk_particles);
-    const int n = d.num_particles, block = scan_block_size(n), chunks = resample_chunks(n);
     detail::for_each_chunk(team, d, [&](int member, int begin, int end) {
+      const int block = scan_block_size(d.num_particles);
       detail::load_weights(team, d, member, begin, end, w, 0);
       team.team_barrier();
       Kokkos::parallel_for(Kokkos::TeamThreadRange(team, (end - begin + block - 1) / block), [&](const int k) {
         const int lo = k * block, hi = lo + block < end - begin ? lo + block : end - begin;
-        d.block_offsets(begin / block + k, member) = detail::add_in_order(w, lo, hi, 0.0, [](int, double) {});
-        Kokkos::memory_fence();  // the sum is out before the count says so
+        d.block_sums(begin / block + k, member) = detail::add_in_order(w, lo, hi, 0.0, [](int, double) {});
       });
-      team.team_barrier();
-      int last = 0;
-      Kokkos::single(
-          Kokkos::PerTeam(team),
-          [&](int& is_last) { is_last = Kokkos::atomic_fetch_add(&d.chunks_done(member), 1) == chunks - 1; }, last);
-      if (last)
-        Kokkos::single(Kokkos::PerTeam(team), [&]() {
-          Kokkos::memory_fence();  // every chunk's sums before the count, read after it
-          detail::exclusive_prefix_in_place(d.block_offsets, member, scan_num_blocks(n));
-          d.chunks_done(member) = 0;  // for the next call: no other team counts this member in this kernel
-        });
     });
   }
 };
@@ -271,10 +189,13 @@ struct ChunkedSystematicScatter {
   using Scratch = Kokkos::View<double*, typename ExecSpace::scratch_memory_space, Kokkos::MemoryUnmanaged>;
   ChunkedResampleData<MemSpace, Real> d;
 
-  /// Team scratch: the chunk's weights and those of the two other chains, the chains' offsets, and the two other
-  /// chains' last cumulative weights.
+  /// Team scratch: the chunk's weights and those of the two other chains (before them, the member's block sums, in
+  /// the same place), the chains' offsets, and the two other chains' last cumulative weights.
   KOKKOS_INLINE_FUNCTION static int chunk_size(int n) { return resample_chunk_blocks(n) * scan_block_size(n); }
-  KOKKOS_INLINE_FUNCTION static int weights_size(int n) { return chunk_size(n) + 2 * scan_block_size(n); }
+  KOKKOS_INLINE_FUNCTION static int weights_size(int n) {
+    const int weights = chunk_size(n) + 2 * scan_block_size(n);
+    return scan_num_blocks(n) > weights ? scan_num_blocks(n) : weights;
+  }
   static std::size_t scratch_bytes(int n) {
     return Scratch::shmem_size(weights_size(n)) + Scratch::shmem_size(resample_chunk_blocks(n) + 2) +
            Scratch::shmem_size(2);
@@ -286,13 +207,21 @@ struct ChunkedSystematicScatter {
         ends(team.team_scratch(0), 2);
     detail::for_each_chunk(team, d, [&](int member, int begin, int end) {
       const detail::ScatterChains chains(n, begin, end);
-      // One round of loads: the chains' offsets (thread k's, issued first) and all their weights.
-      const int rank = team.team_rank(), threads = team.team_size();
-      const double offset = rank < chains.count ? d.block_offsets(chains.block_of(rank), member) : 0.0;
-      detail::load_chain_weights<resample_batch + resample_batch / 2>(team, d, member, chains, size, w);
-      if (rank < chains.count) offsets(rank) = offset;
-      for (int k = rank + threads; k < chains.count; k += threads)
-        offsets(k) = d.block_offsets(chains.block_of(k), member);
+      // Each chain's offset: the member's block sums before its block, added in index order.
+      Kokkos::parallel_for(Kokkos::TeamThreadRange(team, scan_num_blocks(n)),
+                           [&](const int b) { w(b) = d.block_sums(b, member); });
+      team.team_barrier();
+      Kokkos::parallel_for(Kokkos::TeamThreadRange(team, chains.count), [&](const int k) {
+        double offset = 0.0;
+        for (int b = 0; b < chains.block_of(k); ++b) offset += w(b);
+        offsets(k) = offset;
+      });
+      team.team_barrier();
+      detail::load_weights(team, d, member, begin, end, w, 0);
+      for (int k = chains.blocks; k < chains.count; ++k) {
+        const int first = chains.first_particle(k);
+        detail::load_weights(team, d, member, first, first + chains.length(k), w, chains.scratch_at(k, size));
+      }
       team.team_barrier();
       Kokkos::parallel_for(Kokkos::TeamThreadRange(team, chains.count), [&](const int k) {
         const int lo = chains.scratch_at(k, size), hi = lo + chains.length(k);
@@ -374,11 +303,10 @@ void chunked_systematic_resample(const ExecSpace& space,
   // copies them to constant memory first, and waits for the launch before).
   using Policy = Kokkos::TeamPolicy<ExecSpace, Kokkos::Experimental::WorkItemProperty::HintLightWeight_t>;
   const int n = d.num_particles;
-  Kokkos::parallel_for(
-      "kushner::resample_block_offsets",
-      Policy(space, league, team_size)
-          .set_scratch_size(0, Kokkos::PerTeam(ChunkedBlockOffsets<ExecSpace, Real>::scratch_bytes(n))),
-      ChunkedBlockOffsets<ExecSpace, Real>{d});
+  Kokkos::parallel_for("kushner::resample_block_sums",
+                       Policy(space, league, team_size)
+                           .set_scratch_size(0, Kokkos::PerTeam(ChunkedBlockSums<ExecSpace, Real>::scratch_bytes(n))),
+                       ChunkedBlockSums<ExecSpace, Real>{d});
   Kokkos::parallel_for(
       "kushner::resample_scatter",
       Policy(space, league, team_size)
