@@ -264,12 +264,12 @@ class ParticleFilterBank {
                                                  options_.scheme, seed_, d.step});
   }
 
-  /// The posterior of a step from its block partials, into `out` and `log_normalizer` (and the status into
-  /// `status_copy` where allocated); resampling decisions and counts into the bank's, and the members to resample into
-  /// the next of its two lists (whose size it found zero), the other list's size set to zero for the posterior after.
+  /// The posterior of a step from its block partials, into `out` and `log_normalizer` (the members' status into
+  /// out.status too, where that is not the bank's own); resampling decisions and counts into the bank's, and the
+  /// members to resample into the next of its two lists (whose size it found zero), the other list's size set to zero
+  /// for the posterior after.
   void run_posterior(const Kokkos::View<double***, Kokkos::LayoutLeft, MemSpace>& partials, const PosteriorViews& out,
-                     const BankScalar<double, MemSpace>& log_normalizer, bool update_reference,
-                     const BankScalar<Status, MemSpace>& status_copy = {}) {
+                     const BankScalar<double, MemSpace>& log_normalizer, bool update_reference) {
     ParticlePosterior<state_dim, MemSpace> posterior{
         partials, num_blocks_,    reference_, update_reference, out.mean, out.covariance,
         out.ess,  log_normalizer, resample_,  resample_count_,  status_,  options_.ess_threshold * num_particles_};
@@ -279,7 +279,7 @@ class ParticleFilterBank {
       posterior.resample_list_size = resample_list_sizes_[list_];
       posterior.next_list_size = resample_list_sizes_[1 - list_];
     }
-    posterior.status_copy = status_copy;
+    if (out.status.data() != status_.data()) posterior.status_copy = out.status;
     parallel_for_members("kushner::particle_posterior", space_, num_members_, posterior);
   }
 
@@ -520,7 +520,7 @@ void ParticleFilterBank<ExecSpace, Model, Real>::step_pair(long k, double dt, co
   std::swap(workspace_.cumulative, log_weight_next_);
   // Step k's posterior. The reference point and log-normalizer stay step k - 1's: both steps of the pass
   // were taken relative to them.
-  run_posterior(partials_, first_, first_log_normalizer_, false, first_.status);
+  run_posterior(partials_, first_, first_log_normalizer_, false);
   // The members step k resamples: step k again, in the second bank (from step k - 1's particles, no copy of them);
   // resampled from there into the bank (log-weights 0, log-normalizer log N: no copy back); step k + 1 again.
   ParticleStepData<Model, MemSpace, Real> again = step_data(k * dt, dt, first, dy);

@@ -112,6 +112,31 @@ TEST_P(ParticleKernels, ResamplesWhenEssFallsAndResetsTheWeights) {
   (void)before;
 }
 
+TEST(ParticleFilterBank, StepPairsFirstStepHasTheStatusAfterIt) {
+  // A member killed by a non-finite observation at the first step of a fused pair: first_step() says so (the
+  // reference's first scores read it), the other members stay ok.
+  CubicOscillatorModel model;
+  model.prior_mean = Vec<2>{{1.0, 0.5}};
+  model.prior_cov = Mat<2, 2>::diagonal(0.1);
+  const int members = 3, particles = 700;
+  ParticleFilterOptions options;
+  options.kernel = ParticleKernel::team;
+  ParticleFilterBank<Host, CubicOscillatorModel> pf(Host(), model, members, particles, seed, options);
+  ASSERT_TRUE(pf.fuses_step_pairs());
+  BankVector<Kokkos::HostSpace> dy("dy", members, 2), dy_next("dy_next", members, 2);
+  Kokkos::deep_copy(dy, 0.01);
+  Kokkos::deep_copy(dy_next, 0.01);
+  for (int k = 0; k < 8; k += 2) {
+    dy(1, 0) = k == 4 ? std::nan("") : 0.01;
+    pf.step_pair(k, 0.01, dy, dy_next);
+    Host().fence();
+    EXPECT_EQ(pf.first_step().status(0), Status::ok) << k;
+    EXPECT_EQ(pf.first_step().status(1), k < 4 ? Status::ok : Status::non_finite) << k;
+    EXPECT_EQ(pf.first_step().status(2), Status::ok) << k;
+  }
+  EXPECT_EQ(pf.status()(1), Status::non_finite);
+}
+
 TEST_P(ParticleKernels, NonFiniteObservationKillsOnlyThatMember) {
   CubicOscillatorModel model;
   model.prior_mean = Vec<2>{{1.0, 0.5}};

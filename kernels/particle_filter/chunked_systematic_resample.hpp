@@ -124,7 +124,8 @@ KOKKOS_INLINE_FUNCTION double add_in_order(const Scratch& w, int lo, int hi, dou
 
 /// The scan blocks whose cumulative weights the scatter of a chunk needs, a chain each: the chunk's own blocks
 /// (chains 0 .. blocks - 1, each C_j kept), then the block before the chunk (for C_{begin-1}) and the member's last
-/// block (for the total C_{N-1}) where the chunk holds neither (their last C alone kept: ends(0) and ends(1)).
+/// block (for the total C_{N-1}) where the chunk holds neither (their last C alone kept: ends(0) and ends(1)). Kernel
+/// 1 sums the chunk's own blocks, chains 0 .. blocks - 1.
 struct ScatterChains {
   int n, block, first_block, blocks, previous, last;  // previous, last: block indices, or -1
   int count;                                          // chains
@@ -168,12 +169,12 @@ struct ChunkedBlockSums {
   KOKKOS_INLINE_FUNCTION void operator()(const Team& team) const {
     const Scratch w(team.team_scratch(0), resample_chunk_particles);
     detail::for_each_chunk(team, d, [&](int member, int begin, int end) {
-      const int block = scan_block_size(d.num_particles);
+      const detail::ScatterChains chains(d.num_particles, begin, end);  // the chunk's own blocks: chains < blocks
       detail::load_weights(team, d, member, begin, end, w, 0);
       team.team_barrier();
-      Kokkos::parallel_for(Kokkos::TeamThreadRange(team, (end - begin + block - 1) / block), [&](const int k) {
-        const int lo = k * block, hi = lo + block < end - begin ? lo + block : end - begin;
-        d.block_sums(begin / block + k, member) = detail::add_in_order(w, lo, hi, 0.0, [](int, double) {});
+      Kokkos::parallel_for(Kokkos::TeamThreadRange(team, chains.blocks), [&](const int k) {
+        const int lo = k * chains.block, hi = lo + chains.length(k);
+        d.block_sums(chains.block_of(k), member) = detail::add_in_order(w, lo, hi, 0.0, [](int, double) {});
       });
     });
   }
